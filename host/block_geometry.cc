@@ -1,0 +1,175 @@
+#include "sapmvs/block_geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "sapmvs/dem.h"
+
+namespace sapmvs {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Optical axes closer to parallel than this do not triangulate a usable point.
+constexpr double kMinAxisAngleRad = 3.0 * 3.14159265358979 / 180.0;
+// Largest gap between two optical axes, relative to the range, for their
+// closest approach to count as a scene point.
+constexpr double kMaxAxisGap = 0.05;
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+Eigen::Vector2d CenterPixel(const Camera& cam) {
+  return {0.5 * (cam.width() - 1), 0.5 * (cam.height() - 1)};
+}
+
+// Intersection of the ray through `uv` with the plane Z = z; NaN when it
+// does not go towards the plane.
+Eigen::Vector3d OnPlaneZ(const Camera& cam, const Eigen::Vector2d& uv, double z) {
+  const Eigen::Vector3d d = cam.Ray(uv);
+  const double t = (z - cam.center().z()) / d.z();
+  if (!(t > 0) || !std::isfinite(t)) return Eigen::Vector3d::Constant(kNaN);
+  return cam.center() + t * d;
+}
+
+// Midpoints of the shortest segments between convergent optical axes.
+std::vector<Eigen::Vector3d> AxisIntersections(const Block& block) {
+  std::vector<Eigen::Vector3d> out;
+  const size_t n = block.images.size();
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      const Camera& a = block.images[i].camera;
+      const Camera& b = block.images[j].camera;
+      const Eigen::Vector3d da = a.ViewingDirection(), db = b.ViewingDirection();
+      const double c = da.dot(db);
+      if (std::acos(std::clamp(c, -1.0, 1.0)) < kMinAxisAngleRad) continue;
+      const Eigen::Vector3d w = a.center() - b.center();
+      const double den = 1 - c * c;
+      const double sa = (c * db.dot(w) - da.dot(w)) / den;
+      const double sb = (db.dot(w) - c * da.dot(w)) / den;
+      if (sa <= 0 || sb <= 0) continue;
+      // Axes that pass each other far apart (oblique views in opposite
+      // directions) meet nowhere near the scene.
+      const Eigen::Vector3d pa = a.center() + sa * da, pb = b.center() + sb * db;
+      if ((pa - pb).norm() > kMaxAxisGap * std::min(sa, sb)) continue;
+      const Eigen::Vector3d p = 0.5 * (pa + pb);
+      if (a.InImage(a.Project(p)) && b.InImage(b.Project(p))) out.push_back(p);
+    }
+  }
+  return out;
+}
+
+// Median depth of the points that project into the image.
+std::optional<double> MedianDepth(const Camera& cam, const std::vector<Eigen::Vector3d>& pts) {
+  std::vector<double> depths;
+  for (const Eigen::Vector3d& p : pts) {
+    const double d = cam.Depth(p);
+    if (d > 0 && cam.InImage(cam.Project(p))) depths.push_back(d);
+  }
+  if (depths.empty()) return std::nullopt;
+  return Median(depths);
+}
+
+}  // namespace
+
+std::string ToString(SurfaceSource source) {
+  switch (source) {
+    case SurfaceSource::kDem:
+      return "DEM";
+    case SurfaceSource::kSparsePoints:
+      return "sparse points";
+    case SurfaceSource::kGroundHeight:
+      return "ground height";
+    case SurfaceSource::kConvergentAxes:
+      return "convergent optical axes";
+    case SurfaceSource::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+BlockGeometry EstimateBlockGeometry(const Block& block) {
+  BlockGeometry g;
+  g.images.resize(block.images.size());
+  std::optional<Dem> dem;
+  if (!block.dem.empty()) dem = Dem::Load(block.dem);
+  std::vector<Eigen::Vector3d> axis_points;
+  if (!dem && block.sparse_points.empty() && !block.ground_height) {
+    axis_points = AxisIntersections(block);
+  }
+  if (dem)
+    g.source = SurfaceSource::kDem;
+  else if (!block.sparse_points.empty())
+    g.source = SurfaceSource::kSparsePoints;
+  else if (block.ground_height)
+    g.source = SurfaceSource::kGroundHeight;
+  else if (!axis_points.empty())
+    g.source = SurfaceSource::kConvergentAxes;
+
+  int down = 0;
+  std::vector<double> gsds, heights;
+  for (size_t i = 0; i < block.images.size(); ++i) {
+    const Camera& cam = block.images[i].camera;
+    ImageGeometry& ig = g.images[i];
+    ig.looks_down = cam.ViewingDirection().z() < -0.5;
+    down += ig.looks_down;
+    const Eigen::Vector2d center = CenterPixel(cam);
+    Eigen::Vector3d p = Eigen::Vector3d::Constant(kNaN);
+    switch (g.source) {
+      case SurfaceSource::kDem:
+        p = dem->Intersect(cam.center(), cam.ViewingDirection());
+        if (!p.allFinite()) p = OnPlaneZ(cam, center, dem->MedianHeight());
+        break;
+      case SurfaceSource::kSparsePoints:
+      case SurfaceSource::kConvergentAxes:
+        if (auto d = MedianDepth(cam, g.source == SurfaceSource::kSparsePoints ? block.sparse_points
+                                                                               : axis_points)) {
+          p = cam.BackProject(center, *d);
+        }
+        break;
+      case SurfaceSource::kGroundHeight:
+        p = OnPlaneZ(cam, center, *block.ground_height);
+        break;
+      case SurfaceSource::kNone:
+        break;
+    }
+    if (!p.allFinite()) continue;
+    ig.valid = true;
+    ig.scene_point = p;
+    ig.depth = cam.Depth(p);
+    ig.height_above = cam.center().z() - p.z();
+    ig.gsd = ig.looks_down ? cam.Footprint(p, Eigen::Vector3d::UnitZ()) : cam.FootprintFacing(p);
+    const double w = cam.width() - 0.5, h = cam.height() - 0.5;
+    const Eigen::Vector2d corners[4] = {{-0.5, -0.5}, {w, -0.5}, {w, h}, {-0.5, h}};
+    for (int k = 0; k < 4; ++k) {
+      Eigen::Vector3d q =
+          ig.looks_down ? OnPlaneZ(cam, corners[k], p.z()) : Eigen::Vector3d::Constant(kNaN);
+      if (!q.allFinite()) q = cam.BackProject(corners[k], ig.depth);
+      ig.footprint[k] = q;
+    }
+    gsds.push_back(ig.gsd);
+    heights.push_back(ig.height_above);
+    if (g.num_valid == 0) g.extent_min = g.extent_max = ig.footprint[0];
+    for (const Eigen::Vector3d& q : ig.footprint) {
+      g.extent_min = g.extent_min.cwiseMin(q);
+      g.extent_max = g.extent_max.cwiseMax(q);
+    }
+    ++g.num_valid;
+  }
+  g.aerial = 2 * down > static_cast<int>(block.images.size());
+  if (!gsds.empty()) {
+    g.gsd_min = *std::min_element(gsds.begin(), gsds.end());
+    g.gsd_max = *std::max_element(gsds.begin(), gsds.end());
+    g.gsd_median = Median(gsds);
+    double sum = 0;
+    for (double h : heights) sum += h;
+    g.flying_height = sum / static_cast<double>(heights.size());
+  }
+  return g;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,197 @@
+// OpenSfM reconstruction.json (also what OpenDroneMap writes under opensfm/).
+// Cameras: focal and principal point normalised by max(width, height), the
+// principal point as an offset from the image centre. Shots: `rotation` is an
+// angle-axis world-to-camera rotation, x_cam = R X + translation, OpenCV frame.
+// The world frame is topocentric ENU about `reference_lla`.
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "sapmvs/block_reader.h"
+#include "sapmvs/error.h"
+#include "sapmvs/image_io.h"
+
+namespace sapmvs {
+namespace fs = std::filesystem;
+namespace {
+
+using json = nlohmann::json;
+
+// JSON values carry no line numbers; errors name the JSON path and the line
+// where the nearest enclosing key first appears in the file.
+class JsonFile {
+ public:
+  explicit JsonFile(const fs::path& path) : path_(path.string()) {
+    std::ifstream in(path);
+    if (!fs::is_regular_file(path) || !in) throw Error(path_ + ": cannot open file");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text_ = ss.str();
+    try {
+      root_ = json::parse(text_);
+    } catch (const json::parse_error& e) {
+      throw InputError(path_, LineAt(e.byte), std::string("not valid JSON: ") + e.what());
+    }
+  }
+
+  const json& root() const { return root_; }
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& json_path,
+                         const std::string& message) const {
+    const size_t pos = text_.find("\"" + key + "\"");
+    throw InputError(path_, pos == std::string::npos ? 0 : LineAt(pos + 1),
+                     json_path + ": " + message);
+  }
+
+  double Number(const json& obj, const std::string& key, const std::string& where,
+                const std::string& anchor) const {
+    if (!obj.is_object() || !obj.contains(key)) Fail(anchor, where, "missing number '" + key + "'");
+    const json& v = obj[key];
+    if (!v.is_number()) Fail(anchor, where + "/" + key, "expected a number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) Fail(anchor, where + "/" + key, "expected a finite number");
+    return d;
+  }
+
+  Eigen::Vector3d Vector3(const json& obj, const std::string& key, const std::string& where,
+                          const std::string& anchor) const {
+    if (!obj.contains(key) || !obj[key].is_array() || obj[key].size() != 3) {
+      Fail(anchor, where + "/" + key, "expected an array of 3 numbers");
+    }
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) {
+      if (!obj[key][i].is_number())
+        Fail(anchor, where + "/" + key, "expected an array of 3 numbers");
+      v[i] = obj[key][i].get<double>();
+    }
+    if (!v.allFinite()) Fail(anchor, where + "/" + key, "expected finite numbers");
+    return v;
+  }
+
+ private:
+  int LineAt(size_t byte) const {
+    const size_t end = std::min(byte, text_.size());
+    return 1 + static_cast<int>(std::count(text_.begin(), text_.begin() + end, '\n'));
+  }
+
+  std::string path_;
+  std::string text_;
+  json root_;
+};
+
+Intrinsics ReadCamera(const JsonFile& f, const std::string& id, const json& c) {
+  const std::string where = "cameras/" + id;
+  if (!c.is_object()) f.Fail(id, where, "expected an object");
+  const std::string type = c.value("projection_type", "");
+  const int w = static_cast<int>(f.Number(c, "width", where, id));
+  const int h = static_cast<int>(f.Number(c, "height", where, id));
+  if (w <= 0 || h <= 0) f.Fail(id, where, "expected a positive width and height");
+  const double size = std::max(w, h);
+  Intrinsics k;
+  if (type == "perspective") {
+    const double focal = f.Number(c, "focal", where, id) * size;
+    k = Intrinsics::FromPixels(focal, focal, 0.5 * (w - 1), 0.5 * (h - 1), w, h);
+    k.distortion.k1 = c.contains("k1") ? f.Number(c, "k1", where, id) : 0.0;
+    k.distortion.k2 = c.contains("k2") ? f.Number(c, "k2", where, id) : 0.0;
+  } else if (type == "brown" || type == "simple_radial" || type == "radial") {
+    k = Intrinsics::FromPixels(f.Number(c, "focal_x", where, id) * size,
+                               f.Number(c, "focal_y", where, id) * size,
+                               0.5 * (w - 1) + f.Number(c, "c_x", where, id) * size,
+                               0.5 * (h - 1) + f.Number(c, "c_y", where, id) * size, w, h);
+    k.distortion.k1 = f.Number(c, "k1", where, id);
+    if (type != "simple_radial") k.distortion.k2 = f.Number(c, "k2", where, id);
+    if (type == "brown") {
+      k.distortion.k3 = f.Number(c, "k3", where, id);
+      k.distortion.p1 = f.Number(c, "p1", where, id);
+      k.distortion.p2 = f.Number(c, "p2", where, id);
+    }
+  } else {
+    f.Fail(id, where + "/projection_type",
+           "unsupported projection type '" + type +
+               "': expected perspective, brown, simple_radial or radial");
+  }
+  if (!(k.fx > 0 && k.fy > 0)) f.Fail(id, where, "expected a positive focal length");
+  return k;
+}
+
+fs::path JsonPath(const fs::path& given) {
+  if (fs::is_regular_file(given)) return given;
+  if (fs::is_regular_file(given / "reconstruction.json")) return given / "reconstruction.json";
+  return given / "opensfm" / "reconstruction.json";
+}
+
+}  // namespace
+
+Block ReadOpenSfmBlock(const fs::path& given, const BlockReadOptions& options) {
+  const fs::path path = JsonPath(given);
+  const JsonFile f(path);
+  const json& root = f.root();
+  if (!root.is_array() || root.empty() || !root[0].is_object()) {
+    throw InputError(path.string(), 1, "expected an array of reconstructions");
+  }
+  const json& rec = root[0];
+  if (!rec.contains("cameras") || !rec["cameras"].is_object())
+    f.Fail("cameras", "[0]", "missing object 'cameras'");
+  if (!rec.contains("shots") || !rec["shots"].is_object())
+    f.Fail("shots", "[0]", "missing object 'shots'");
+
+  std::map<std::string, Intrinsics> cameras;
+  for (const auto& [id, c] : rec["cameras"].items()) cameras[id] = ReadCamera(f, id, c);
+
+  fs::path image_dir = options.image_dir;
+  if (image_dir.empty()) {
+    image_dir = path.parent_path() / "images";
+    if (!fs::is_directory(image_dir)) image_dir = path.parent_path().parent_path() / "images";
+  }
+
+  Block block;
+  if (rec.contains("reference_lla") && rec["reference_lla"].is_object()) {
+    const json& r = rec["reference_lla"];
+    std::ostringstream note;
+    note.precision(10);
+    note << "topocentric ENU about lat "
+         << f.Number(r, "latitude", "reference_lla", "reference_lla") << ", lon "
+         << f.Number(r, "longitude", "reference_lla", "reference_lla") << ", alt "
+         << f.Number(r, "altitude", "reference_lla", "reference_lla") << " (OpenSfM reference_lla)";
+    block.frame_note = note.str();
+  } else {
+    block.frame_note = "OpenSfM local frame";
+  }
+  if (root.size() > 1) block.frame_note += "; reconstruction 1 of " + std::to_string(root.size());
+
+  for (const auto& [id, shot] : rec["shots"].items()) {
+    const std::string where = "shots/" + id;
+    if (!shot.is_object() || !shot.contains("camera") || !shot["camera"].is_string()) {
+      f.Fail(id, where, "expected an object with a 'camera' name");
+    }
+    const auto cam = cameras.find(shot["camera"].get<std::string>());
+    if (cam == cameras.end())
+      f.Fail(id, where + "/camera", "unknown camera '" + shot["camera"].get<std::string>() + "'");
+    const Eigen::Vector3d aa = f.Vector3(shot, "rotation", where, id);
+    const Eigen::Vector3d t = f.Vector3(shot, "translation", where, id);
+    const double angle = aa.norm();
+    const Eigen::Matrix3d r = angle < 1e-15
+                                  ? Eigen::Matrix3d::Identity()
+                                  : Eigen::AngleAxisd(angle, aa / angle).toRotationMatrix();
+    BlockImage im;
+    im.name = id;
+    im.camera_name = cam->first;
+    im.camera = Camera(cam->second, r, -r.transpose() * t);
+    im.path = FindImageFile(image_dir, id);
+    if (im.path.empty())
+      f.Fail(id, where, "no image for shot '" + id + "' in " + image_dir.string());
+    block.images.push_back(std::move(im));
+  }
+  if (rec.contains("points") && rec["points"].is_object()) {
+    for (const auto& [id, p] : rec["points"].items()) {
+      block.sparse_points.push_back(f.Vector3(p, "coordinates", "points/" + id, id));
+    }
+  }
+  return block;
+}
+
+}  // namespace sapmvs

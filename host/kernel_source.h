@@ -1,0 +1,26 @@
+#pragma once
+// Where kernel source comes from. Release binaries carry kernels/*.cl inside
+// them (cmake/EmbedKernels.cmake), so an installed `sapmvs` never depends on
+// the source tree. For kernel development, SAPMVS_KERNEL_DIR=<dir> makes every
+// lookup read <dir>/<file> from disk instead, so an edited kernel is picked up
+// without rebuilding the host.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sapmvs {
+
+// The source of kernels/<file>, e.g. KernelSource("bilinear_sample.cl"): from
+// $SAPMVS_KERNEL_DIR/<file> when that variable is set and non-empty, else the
+// embedded copy. Throws Error naming the file (and the available files, or the
+// path that could not be read).
+std::string KernelSource(std::string_view file);
+
+// The embedded copy only, ignoring SAPMVS_KERNEL_DIR. Throws like KernelSource.
+std::string EmbeddedKernelSource(std::string_view file);
+
+// Names of the embedded kernel files, sorted.
+std::vector<std::string> EmbeddedKernelFiles();
+
+}  // namespace sapmvs

@@ -1,0 +1,290 @@
+#include "sapmvs/simulate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "sapmvs/atomic_file.h"
+#include "sapmvs/camera.h"
+#include "sapmvs/error.h"
+#include "sapmvs/las_io.h"
+#include "sapmvs/progress.h"
+#include "sapmvs/raster_io.h"
+#include "sim_lidar.h"
+#include "sim_presets.h"
+
+namespace sapmvs {
+namespace fs = std::filesystem;
+namespace {
+
+// Projected CRS of the simulated coordinates: UTM 32N, where X ~ 5e5 and
+// Y ~ 5.4e6 lie (southern Germany, like Vaihingen).
+constexpr char kCrs[] = "EPSG:32632";
+
+uint64_t Mix(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// A standard normal value from a hash, so that the noise of a pixel does not
+// depend on which thread renders it.
+double HashGauss(uint64_t key) {
+  const uint64_t a = Mix(key), b = Mix(a ^ 0x5851f42d4c957f2dULL);
+  const double u1 = (static_cast<double>(a >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+  const double u2 = static_cast<double>(b >> 11) * (1.0 / 9007199254740992.0);
+  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * M_PI * u2);
+}
+
+cv::Mat Render(const sim::Scene& scene, const Camera& cam, const SimulateOptions& o, double gain,
+               uint64_t image_key) {
+  const int w = cam.width(), h = cam.height(), ss = o.supersampling;
+  cv::Mat img(h, w, CV_8UC3);
+  const Eigen::Vector3d sky(0.65, 0.72, 0.80);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      Eigen::Vector3d acc = Eigen::Vector3d::Zero();
+      for (int sy = 0; sy < ss; ++sy) {
+        for (int sx = 0; sx < ss; ++sx) {
+          const Eigen::Vector2d uv(u - 0.5 + (sx + 0.5) / ss, v - 0.5 + (sy + 0.5) / ss);
+          const sim::Hit hit = scene.Intersect(cam.center(), cam.Ray(uv));
+          acc += hit.valid ? scene.Shade(hit) : sky;
+        }
+      }
+      acc /= ss * ss;
+      cv::Vec3b& px = img.at<cv::Vec3b>(v, u);
+      for (int c = 0; c < 3; ++c) {
+        const uint64_t key = image_key ^ ((static_cast<uint64_t>(v) * w + u) * 4 + c);
+        const double value = sim::EncodeChannel(acc[c], gain) + o.noise * HashGauss(key);
+        px[2 - c] = cv::saturate_cast<uchar>(std::lround(value));  // OpenCV stores BGR
+      }
+    }
+  }
+  return img;
+}
+
+void WriteText(const fs::path& path, const std::string& text) {
+  WriteFileAtomically(path, [&](const fs::path& tmp) {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw Error(path.string() + ": cannot write");
+  });
+}
+
+void WritePng(const fs::path& path, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", image, bytes)) throw Error(path.string() + ": PNG encoding failed");
+  WriteFileAtomically(path, [&](const fs::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw Error(path.string() + ": cannot write");
+  });
+}
+
+std::string Fixed(double v, int precision) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(precision) << v;
+  return s.str();
+}
+
+}  // namespace
+
+namespace sim {
+
+double EncodeChannel(double linear, double gain) {
+  return 255.0 * std::pow(std::clamp(linear * gain, 0.0, 1.0), 1 / 2.2);
+}
+
+Eigen::Vector3d WorldOffset(double scene_width, double scene_height) {
+  return {std::round(500000 - scene_width / 2), std::round(5400000 - scene_height / 2), 300};
+}
+
+}  // namespace sim
+
+std::vector<std::string> SimulatePresetNames() {
+  std::vector<std::string> names;
+  for (const sim::Preset& p : sim::AllPresets()) names.push_back(p.name);
+  return names;
+}
+
+bool SimulateOptions::Check() const {
+  // The CLI reports the first problem through Simulate(); here only a verdict.
+  try {
+    sim::FindPreset(preset);
+    if (!angles.empty()) ParseAngleOrder(angles);
+    if (!units.empty()) ParseAngleUnit(units);
+  } catch (const Error&) {
+    return false;
+  }
+  return !out.empty() && scale > 0 && scale <= 4 && supersampling >= 2 && supersampling <= 8 &&
+         noise >= 0 && noise <= 50 && exposure <= 0.5;
+}
+
+SimulatedWorld BuildWorld(const SimulateOptions& o) {
+  const sim::Preset preset = sim::FindPreset(o.preset);
+  if (o.out.empty()) throw Error("simulate: no output folder given (--out DIR)");
+  if (!(o.scale > 0 && o.scale <= 4)) {
+    throw Error("simulate: --scale " + std::to_string(o.scale) + " is outside (0, 4]");
+  }
+  if (o.supersampling < 2 || o.supersampling > 8) {
+    throw Error("simulate: --supersampling " + std::to_string(o.supersampling) +
+                " is outside 2..8");
+  }
+  if (!(o.noise >= 0 && o.noise <= 50))
+    throw Error("simulate: --noise must be 0 to 50 grey levels");
+  if (!(o.exposure <= 0.5)) throw Error("simulate: --exposure must be at most 0.5");
+  if (!o.angles.empty()) ParseAngleOrder(o.angles);
+  if (!o.units.empty()) ParseAngleUnit(o.units);
+  const sim::CameraSpec camera = sim::ScaledCamera(preset.camera, o.scale);
+  const double exposure = o.exposure >= 0 ? o.exposure : preset.flight.exposure;
+  const sim::FlightPlan plan = sim::PlanFlight(preset, camera, o.cross_strip, exposure, o.seed);
+  sim::SceneSpec spec = preset.scene;
+  spec.width = plan.scene_width;
+  spec.height = plan.scene_height;
+  spec.cell = plan.gsd * preset.cell_per_gsd;
+  SimulatedWorld world{sim::Scene::Generate(spec, o.seed),
+                       plan.images,
+                       {},
+                       plan.gsd,
+                       plan.strips,
+                       camera.width,
+                       camera.height,
+                       camera.focal_mm,
+                       camera.pixel_um};
+  world.offset = sim::WorldOffset(world.scene.width(), world.scene.height());
+  return world;
+}
+
+SimulateSummary Simulate(const SimulateOptions& o) {
+  const sim::Preset preset = sim::FindPreset(o.preset);
+  SimulateSummary summary;
+  summary.order = o.angles.empty() ? preset.order : ParseAngleOrder(o.angles);
+  summary.unit = o.units.empty() ? preset.unit : ParseAngleUnit(o.units);
+  const SimulatedWorld world = [&] {
+    Progress p("scene", 1, !o.quiet);
+    SimulatedWorld w = BuildWorld(o);
+    p.Advance();
+    return w;
+  }();
+  const sim::Scene& scene = world.scene;
+  const Eigen::Vector3d& offset = world.offset;
+  fs::create_directories(o.out / "images");
+  fs::create_directories(o.out / "truth");
+  const Intrinsics k =
+      Intrinsics::FromFocalAndPixel(world.focal_mm, world.pixel_um, world.width, world.height);
+
+  std::ostringstream orientation;
+  orientation << "# sapmvs simulate --preset " << o.preset << " --seed " << o.seed << "\n"
+              << "# name X Y Z "
+              << (summary.order == AngleOrder::kOmegaPhiKappa ? "omega phi kappa"
+                                                              : "phi omega kappa")
+              << " (" << ToString(summary.unit) << ")\n";
+  std::ostringstream exposure_txt;
+  exposure_txt << "# name gain (the factor each image's linear radiance was multiplied by)\n";
+  {
+    Progress p("render", static_cast<long>(world.images.size()), !o.quiet);
+    for (size_t i = 0; i < world.images.size(); ++i) {
+      const PlannedImage& im = world.images[i];
+      const Camera cam = Camera::FromAngles(k, im.center, im.omega, im.phi, im.kappa,
+                                            AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
+      WritePng(o.out / "images" / (im.name + ".png"),
+               Render(scene, cam, o, im.gain, Mix(o.seed * 1000003 + i)));
+      const Eigen::Vector3d a =
+          AnglesFromWorldToCamera(cam.rotation(), summary.order, summary.unit);
+      const Eigen::Vector3d c = im.center + offset;
+      const int digits = summary.unit == AngleUnit::kRadian ? 12 : 10;
+      orientation << im.name << " " << Fixed(c.x(), 4) << " " << Fixed(c.y(), 4) << " "
+                  << Fixed(c.z(), 4) << " " << Fixed(a[0], digits) << " " << Fixed(a[1], digits)
+                  << " " << Fixed(a[2], digits) << "\n";
+      exposure_txt << im.name << " " << Fixed(im.gain, 6) << "\n";
+      p.Advance(1, im.name);
+    }
+  }
+  WriteText(o.out / "orientation.txt", orientation.str());
+  WriteText(o.out / "truth" / "exposure.txt", exposure_txt.str());
+
+  std::ostringstream yaml;
+  yaml << "# Synthetic block from `sapmvs simulate --preset " << o.preset << " --seed " << o.seed
+       << "`: " << preset.description << ".\n"
+       << "crs: \"" << kCrs << "\"\n"
+       << "dem: truth/dsm.tif\n"
+       << "camera:\n  name: " << preset.name << " camera\n"
+       << "  width: " << world.width << "\n  height: " << world.height << "\n"
+       << "  focal_mm: " << Fixed(world.focal_mm, 6) << "\n  pixel_um: " << Fixed(world.pixel_um, 9)
+       << "\n"
+       << "images: images\n"
+       << "orientation:\n  file: orientation.txt\n  type: angles\n"
+       << "  angles: " << ToString(summary.order) << "\n  units: " << ToString(summary.unit)
+       << "\n";
+  WriteText(o.out / "block.yaml", yaml.str());
+
+  // The truth DSM: the cell tops, north-up.
+  GeoRaster dsm;
+  dsm.width = scene.nx();
+  dsm.height = scene.ny();
+  dsm.cell_size = scene.cell();
+  dsm.origin_x = offset.x();
+  dsm.origin_y = offset.y() + scene.ny() * scene.cell();
+  dsm.crs = kCrs;
+  dsm.values.resize(static_cast<size_t>(dsm.width) * dsm.height);
+  for (int row = 0; row < dsm.height; ++row)
+    for (int col = 0; col < dsm.width; ++col)
+      dsm.at(col, row) =
+          static_cast<float>(scene.CellHeight(col, dsm.height - 1 - row) + offset.z());
+  WriteGeoTiff(o.out / "truth" / "dsm.tif", dsm);
+
+  sim::LidarSpec lidar;
+  lidar.density = sim::LidarDensityForGsd(world.gsd);
+  lidar.flying_height = std::max(300.0, 2 * preset.flight.flying_height / 3);
+  const double m = 0.1 * std::min(scene.width(), scene.height());
+  lidar.min = Eigen::Vector2d(m, m);
+  lidar.max = Eigen::Vector2d(scene.width() - m, scene.height() - m);
+  const std::vector<PointRecord> points = sim::SimulateLidar(scene, lidar, offset, o.seed);
+  LasWriteOptions las;
+  las.crs = kCrs;
+  // A fixed date keeps the bytes a function of the seed (the paper's year).
+  las.creation_day = 1;
+  las.creation_year = 2016;
+  WriteLas(o.out / "truth" / "lidar.las", points, las);
+  if (o.xyz) WriteXyz(o.out / "truth" / "lidar.xyz", points, 3);
+
+  summary.images = static_cast<int>(world.images.size());
+  summary.strips = world.strips;
+  summary.width = world.width;
+  summary.height = world.height;
+  summary.gsd = world.gsd;
+  summary.flying_height = preset.flight.flying_height;
+  summary.lidar_points = static_cast<long>(points.size());
+
+  std::ostringstream readme;
+  readme << "# Synthetic block: " << o.preset << " (seed " << o.seed << ")\n\n"
+         << preset.description << ".\n\n"
+         << "- `block.yaml`, `orientation.txt`: the block (" << summary.images << " images of "
+         << world.width << "x" << world.height << " px in " << summary.strips << " strips; angles "
+         << ToString(summary.order) << " in " << ToString(summary.unit) << "; CRS " << kCrs
+         << ").\n"
+         << "- `images/*.png`: rendered by ray casting the scene, " << o.supersampling << "x"
+         << o.supersampling << " rays per pixel, Lambertian shading, sensor noise " << o.noise
+         << " grey levels.\n"
+         << "- `truth/dsm.tif`: the exact first-surface heights, " << Fixed(scene.cell(), 4)
+         << " m cells (flat-topped: walls are vertical).\n"
+         << "- `truth/lidar.las`" << (o.xyz ? " and `truth/lidar.xyz`" : "") << ": "
+         << points.size() << " simulated first returns, " << Fixed(lidar.density, 2)
+         << " points/m^2 per strip, "
+         << "2 cm vertical and 5 cm horizontal noise; classes 2 ground, 5 vegetation, 6 building, "
+            "9 water.\n"
+         << "- `truth/exposure.txt`: each image's exposure gain.\n\n"
+         << "Nominal GSD " << Fixed(world.gsd, 4) << " m at " << preset.flight.flying_height
+         << " m above the mean ground; world = local + (" << Fixed(offset.x(), 0) << ", "
+         << Fixed(offset.y(), 0) << ", " << Fixed(offset.z(), 0) << ").\n";
+  WriteText(o.out / "truth" / "README.md", readme.str());
+  return summary;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,47 @@
+#pragma once
+// Output files that appear whole or not at all. A run that fails or is killed
+// half-way must not leave a truncated point cloud or raster that a later step
+// (or the user) mistakes for a result, so writers fill a temporary file in the
+// destination's directory and rename it onto the destination, which POSIX
+// makes atomic within one file system.
+
+#include <filesystem>
+#include <functional>
+
+namespace sapmvs {
+
+class AtomicFile {
+ public:
+  // Throws sapmvs::Error naming `path` when its directory does not exist, so
+  // a bad output path fails before any work is spent on the content.
+  explicit AtomicFile(std::filesystem::path path);
+  // Removes the temporary file unless Commit() succeeded.
+  ~AtomicFile();
+
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  // The destination.
+  const std::filesystem::path& path() const { return path_; }
+  // Where to write: `.NAME.tmp.PID.N` beside the destination. Hidden, and
+  // unique per process and object, so concurrent writers do not collide.
+  const std::filesystem::path& temp_path() const { return temp_path_; }
+
+  // Renames the temporary file onto the destination, replacing any file
+  // there. Throws sapmvs::Error naming the destination when the temporary
+  // file is missing or the rename fails; the destination is then untouched.
+  void Commit();
+  bool committed() const { return committed_; }
+
+ private:
+  std::filesystem::path path_;
+  std::filesystem::path temp_path_;
+  bool committed_ = false;
+};
+
+// Calls `write(tmp)` to fill a temporary file and commits it onto `path`. When
+// `write` throws, the exception propagates and neither file is left behind.
+void WriteFileAtomically(const std::filesystem::path& path,
+                         const std::function<void(const std::filesystem::path& tmp)>& write);
+
+}  // namespace sapmvs

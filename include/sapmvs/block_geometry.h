@@ -1,0 +1,45 @@
+#pragma once
+// What a block's geometry says about its scene before any matching: where each
+// image's optical axis meets the surface, its ground sample distance there,
+// its footprint, the flying height and the ground extent. `sapmvs info`
+// prints it; grouping and matching use the depths.
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "sapmvs/block.h"
+
+namespace sapmvs {
+
+// Where the scene surface came from, best first.
+enum class SurfaceSource { kDem, kSparsePoints, kGroundHeight, kConvergentAxes, kNone };
+std::string ToString(SurfaceSource source);
+
+struct ImageGeometry {
+  bool valid = false;           // false when no surface estimate reaches this image
+  bool looks_down = false;      // optical axis within 60 deg of nadir (world -Z)
+  Eigen::Vector3d scene_point;  // surface point on the optical axis
+  double depth = 0;             // its depth, block units
+  double gsd = 0;               // pixel footprint there: on the ground when looking down,
+                                // else on a plane facing the camera (block units)
+  double height_above = 0;      // camera Z minus scene Z
+  std::array<Eigen::Vector3d, 4> footprint;  // image corners on the surface
+};
+
+struct BlockGeometry {
+  SurfaceSource source = SurfaceSource::kNone;
+  std::vector<ImageGeometry> images;  // one per block image
+  int num_valid = 0;
+  bool aerial = false;  // most images look down
+  double gsd_min = 0, gsd_max = 0, gsd_median = 0;
+  double flying_height = 0;  // mean height above the scene (aerial blocks)
+  Eigen::Vector3d extent_min = Eigen::Vector3d::Zero();  // bounding box of the footprints
+  Eigen::Vector3d extent_max = Eigen::Vector3d::Zero();
+};
+
+// Estimates the scene surface from the best source the block offers.
+BlockGeometry EstimateBlockGeometry(const Block& block);
+
+}  // namespace sapmvs

@@ -1,0 +1,50 @@
+#pragma once
+// Block readers. The format is detected from the path given (a file or a
+// folder) unless BlockReadOptions::format names it.
+//   yaml     native block.yaml (see docs in README.md, "Block files")
+//   pmvs     PMVS/CMVS folder: txt/NNNNNNNN.txt (CONTOUR + 3x4 P), visualize/
+//   colmap   COLMAP text model: cameras.txt, images.txt (+ points3D.txt)
+//   strecha  Strecha .camera files (K, distortion, R camera-to-world, C, W H)
+//   opensfm  OpenSfM reconstruction.json (perspective, brown)
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "sapmvs/block.h"
+
+namespace sapmvs {
+
+enum class BlockFormat { kAuto, kYaml, kPmvs, kColmap, kStrecha, kOpenSfm };
+
+// "auto", "yaml", "pmvs", "colmap", "strecha", "opensfm"; throws otherwise.
+BlockFormat ParseBlockFormat(std::string_view text);
+std::string ToString(BlockFormat format);
+
+struct BlockReadOptions {
+  // Format of the block; kAuto detects it from the path.
+  BlockFormat format = BlockFormat::kAuto;
+  // Folder holding the images, overriding where the format says they are.
+  std::filesystem::path image_dir;
+  // Compare every image's header size with its camera (cheap: no decoding).
+  bool check_image_sizes = true;
+
+  bool Check() const;
+};
+
+// Detects the format of `path`; throws naming the path and what was looked
+// for when nothing matches.
+BlockFormat DetectBlockFormat(const std::filesystem::path& path);
+
+// Reads a block. Every image gets its camera, its file and the block's local
+// origin is chosen. Malformed input throws InputError (file:line: expected ...).
+Block ReadBlock(const std::filesystem::path& path, const BlockReadOptions& options = {});
+
+// The individual readers; `path` is what DetectBlockFormat accepted.
+Block ReadYamlBlock(const std::filesystem::path& path, const BlockReadOptions& options);
+Block ReadPmvsBlock(const std::filesystem::path& path, const BlockReadOptions& options);
+Block ReadColmapBlock(const std::filesystem::path& path, const BlockReadOptions& options);
+Block ReadStrechaBlock(const std::filesystem::path& path, const BlockReadOptions& options);
+Block ReadOpenSfmBlock(const std::filesystem::path& path, const BlockReadOptions& options);
+
+}  // namespace sapmvs

@@ -1,0 +1,36 @@
+#pragma once
+// An elevation raster (DEM/DSM) read with GDAL, in the block's frame, with
+// bilinear lookup and ray intersection.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <vector>
+
+namespace sapmvs {
+
+class Dem {
+ public:
+  // Reads band 1 of `path`; throws naming the file when it is not a north-up
+  // raster GDAL can read.
+  static Dem Load(const std::filesystem::path& path);
+
+  // Bilinear height at world (x, y) between cell centres; NaN outside the
+  // raster or where a corner is nodata.
+  double Height(double x, double y) const;
+  // First intersection of the ray center + t dir (t > 0) with the surface,
+  // marched at half a cell; nullopt-like NaN vector when it misses.
+  Eigen::Vector3d Intersect(const Eigen::Vector3d& center, const Eigen::Vector3d& dir) const;
+  // Median of the valid heights.
+  double MedianHeight() const;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  double cell_size() const { return std::abs(geo_[1]); }
+
+ private:
+  int width_ = 0, height_ = 0;
+  double geo_[6] = {0, 1, 0, 0, 0, -1};  // GDAL geotransform
+  std::vector<float> z_;                 // row-major, NaN = nodata
+};
+
+}  // namespace sapmvs

@@ -1,0 +1,28 @@
+#pragma once
+// Every kernel limit and tunable default lives here, and only here. Each .cl
+// file keeps an `#ifndef NAME / #define NAME default` fallback so it compiles on
+// its own (e.g. in an offline compiler), but the host always passes the value
+// from this header as `-D NAME=VALUE`, so the fallbacks never decide anything
+// in a real run. Change a value here, not in a kernel.
+
+namespace sapmvs {
+
+// Work-items per work-group for 1-D kernels. 64 is a multiple of every
+// vendor's SIMD width (NVIDIA 32, AMD 64, PoCL vectorises across it) and far
+// below any device's CL_DEVICE_MAX_WORK_GROUP_SIZE.
+inline constexpr int kDefaultWorkGroupSize = 64;
+
+// Largest side of a square matching window, in pixels (odd). Bounds the
+// per-work-item private arrays of the NCC kernels.
+inline constexpr int kMaxPatchSize = 21;
+
+// Most views (reference + searches) one matching kernel call combines. Bounds
+// the per-work-item arrays of the multi-view kernels.
+inline constexpr int kMaxViews = 8;
+
+// Largest image side the float32 kernels accept, in pixels. Float coordinates
+// are exact integers only up to 2^24, so beyond this a pixel centre could not
+// be addressed exactly.
+inline constexpr int kMaxImageSide = 1 << 24;
+
+}  // namespace sapmvs

@@ -1,0 +1,53 @@
+#pragma once
+// North-up single-band float rasters (DSMs, DEMs, error maps) in and out of
+// GeoTIFF through GDAL, and the CRS conversion the point writers share.
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace sapmvs {
+
+struct GeoRaster {
+  int width = 0, height = 0;
+  // Top-left corner of the top-left cell (not its centre), in CRS units.
+  double origin_x = 0, origin_y = 0;
+  // Square cells; columns run east, rows run south.
+  double cell_size = 1;
+  // Row-major, width * height; row 0 is the north edge.
+  std::vector<float> values;
+  // Cells equal to `nodata` are empty; NaN cells are always empty.
+  float nodata = std::numeric_limits<float>::quiet_NaN();
+  // WKT, "EPSG:n" or a PROJ string when writing; WKT after reading; empty =
+  // no CRS.
+  std::string crs;
+
+  float& at(int col, int row) { return values[static_cast<size_t>(row) * width + col]; }
+  float at(int col, int row) const { return values[static_cast<size_t>(row) * width + col]; }
+  bool IsEmpty(int col, int row) const;
+  // World (x, y) of the centre of cell (col, row).
+  Eigen::Vector2d CellCenter(int col, int row) const {
+    return {origin_x + (col + 0.5) * cell_size, origin_y - (row + 0.5) * cell_size};
+  }
+};
+
+// Writes a float32 GeoTIFF (DEFLATE with the floating-point predictor, 256 px
+// tiles) with the geotransform, nodata value and CRS, atomically. Throws
+// sapmvs::Error naming `path` and the value at fault (inconsistent size, bad
+// cell size, unknown CRS) or the GDAL failure; no file is left behind.
+void WriteGeoTiff(const std::filesystem::path& path, const GeoRaster& raster);
+
+// Reads band 1 of any raster GDAL opens, as float. A south-up raster is
+// flipped to north-up; rotated or non-square cells are refused. Without a
+// nodata value in the file, `nodata` is NaN. Throws sapmvs::InputError naming
+// the file and what was expected.
+GeoRaster ReadGeoRaster(const std::filesystem::path& path);
+
+// Converts a CRS given as WKT, "EPSG:n" or a PROJ string (no network look-up)
+// to OGR's default WKT; "" stays "". Throws sapmvs::Error naming the text.
+std::string CrsToWkt(const std::string& crs);
+
+}  // namespace sapmvs

@@ -1,0 +1,108 @@
+#pragma once
+// Shared fixture for tests that need an OpenCL device. The device comes from
+// SAPMVS_TEST_DEVICE, else SAPMVS_DEVICE, else the PoCL CPU device (the
+// reference device, so results do not depend on which GPU a machine has), else
+// the default device. Without any OpenCL device the tests skip with the reason;
+// a spec that matches nothing fails, since that is a misconfiguration.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "cl_runtime.h"
+
+namespace sapmvs::test {
+
+// Sets (or, with nullopt, unsets) an environment variable for one scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, std::optional<std::string> value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    Set(value);
+  }
+  ~ScopedEnv() { Set(old_); }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  void Set(const std::optional<std::string>& value) {
+    if (value) {
+      setenv(name_.c_str(), value->c_str(), 1);
+    } else {
+      unsetenv(name_.c_str());
+    }
+  }
+
+  std::string name_;
+  std::optional<std::string> old_;
+};
+
+// The device options the tests use (see the file comment).
+inline DeviceOptions TestDeviceOptions(const std::vector<DeviceInfo>& devices) {
+  DeviceOptions options;
+  for (const char* name : {"SAPMVS_TEST_DEVICE", "SAPMVS_DEVICE"}) {
+    if (const char* env = std::getenv(name); env && *env) {
+      options.device = env;
+      return options;
+    }
+  }
+  for (const DeviceInfo& device : devices) {
+    if (device.IsPoclCpu()) {
+      options.device = std::to_string(device.index);
+      return options;
+    }
+  }
+  return options;  // Default device.
+}
+
+class ClTest : public ::testing::Test {
+ protected:
+  struct Shared {
+    std::unique_ptr<ClContext> context;
+    bool skip = false;
+    std::string reason;
+  };
+
+  void SetUp() override {
+    const Shared& shared = GetShared();
+    if (shared.skip) GTEST_SKIP() << shared.reason;
+    ASSERT_TRUE(shared.context) << shared.reason;
+  }
+
+  ClContext& context() { return *GetShared().context; }
+
+  // One context per test process, so programs are built once per process.
+  // Deliberately leaked: releasing OpenCL objects during static destruction
+  // can race the driver's own teardown.
+  static Shared& GetShared() {
+    static Shared* shared = new Shared(CreateShared());
+    return *shared;
+  }
+
+ private:
+  static Shared CreateShared() {
+    Shared shared;
+    std::vector<DeviceInfo> devices;
+    try {
+      devices = ListDevices();
+    } catch (const NoDeviceError& e) {
+      shared.skip = true;
+      shared.reason = std::string("no OpenCL device: ") + e.what();
+      return shared;
+    }
+    try {
+      const DeviceOptions options = TestDeviceOptions(devices);
+      shared.context = std::make_unique<ClContext>(devices[SelectDeviceIndex(devices, options)],
+                                                   /*profile=*/true);
+    } catch (const std::exception& e) {
+      shared.reason = std::string("cannot create the test OpenCL context: ") + e.what();
+    }
+    return shared;
+  }
+};
+
+}  // namespace sapmvs::test

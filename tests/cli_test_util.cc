@@ -1,0 +1,45 @@
+#include "cli_test_util.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace sapmvs::test {
+
+CliResult RunCli(const std::string& args, const std::string& env) {
+  // Not ScratchDir(): that would wipe the calling test's own files.
+  static int calls = 0;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("sapmvs_cli_" + std::to_string(::getpid()) + "_" + std::to_string(++calls));
+  std::filesystem::create_directories(dir);
+  const std::string cmd = env + (env.empty() ? "" : " ") + SAPMVS_CLI_PATH + " " + args + " > " +
+                          (dir / "out.txt").string() + " 2> " + (dir / "err.txt").string() +
+                          " < /dev/null";
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  r.out = slurp(dir / "out.txt");
+  r.err = slurp(dir / "err.txt");
+  std::filesystem::remove_all(dir);
+  return r;
+}
+
+int CountLines(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  if (!text.empty() && text.back() != '\n') ++n;
+  return n;
+}
+
+}  // namespace sapmvs::test

@@ -1,0 +1,265 @@
+#include "sapmvs/simulate.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <sstream>
+
+#include "sapmvs/block_reader.h"
+#include "sapmvs/error.h"
+#include "sapmvs/image_io.h"
+#include "sapmvs/las_io.h"
+#include "sapmvs/raster_io.h"
+#include "test_util.h"
+
+namespace sapmvs {
+namespace {
+
+namespace fs = std::filesystem;
+
+SimulateOptions Tiny(const fs::path& out, double scale = 1.0, uint64_t seed = 1) {
+  SimulateOptions o;
+  o.preset = "tiny";
+  o.out = out;
+  o.seed = seed;
+  o.scale = scale;
+  o.quiet = true;
+  return o;
+}
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<fs::path> FilesUnder(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) files.push_back(fs::relative(e.path(), dir));
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(Simulate, SameSeedSameBytesOtherSeedOtherImages) {
+  const fs::path dir = test::ScratchDir();
+  Simulate(Tiny(dir / "a", 0.5, 7));
+  Simulate(Tiny(dir / "b", 0.5, 7));
+  Simulate(Tiny(dir / "c", 0.5, 8));
+  const auto files = FilesUnder(dir / "a");
+  ASSERT_EQ(files, FilesUnder(dir / "b"));
+  ASSERT_GE(files.size(), 9u);  // block, orientation, 4 images, dsm, las, exposure, README
+  for (const fs::path& f : files) {
+    EXPECT_TRUE(Slurp(dir / "a" / f) == Slurp(dir / "b" / f)) << f << " differs between runs";
+  }
+  EXPECT_FALSE(Slurp(dir / "a/images/IMG_0001.png") == Slurp(dir / "c/images/IMG_0001.png"));
+  // No temporary files are left behind.
+  for (const fs::path& f : files) EXPECT_NE(f.filename().string().front(), '.') << f;
+}
+
+// Exposure gains from truth/exposure.txt.
+std::map<std::string, double> Gains(const fs::path& dir) {
+  std::ifstream in(dir / "truth" / "exposure.txt");
+  std::map<std::string, double> g;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    std::string name;
+    double gain;
+    s >> name >> gain;
+    g[name] = gain;
+  }
+  return g;
+}
+
+double Pearson(const std::vector<double>& a, const std::vector<double>& b) {
+  double ma = 0, mb = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    ma += a[i];
+    mb += b[i];
+  }
+  ma /= a.size();
+  mb /= b.size();
+  double sab = 0, saa = 0, sbb = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return sab / std::sqrt(saa * sbb);
+}
+
+TEST(Simulate, DsmPointsProjectOntoTheirShadedTexture) {
+  const fs::path dir = test::ScratchDir();
+  const SimulateOptions o = Tiny(dir);
+  Simulate(o);
+  // Everything goes through the product's readers: block.yaml, GeoTIFF.
+  const Block block = ReadBlock(dir / "block.yaml");
+  ASSERT_EQ(block.images.size(), 4u);
+  const GeoRaster dsm = ReadGeoRaster(dir / "truth" / "dsm.tif");
+  const SimulatedWorld world = BuildWorld(o);
+  const auto gains = Gains(dir);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> col(3, dsm.width - 4), row(3, dsm.height - 4);
+  std::vector<double> predicted, rendered, shifted;
+  for (const BlockImage& im : block.images) {
+    const cv::Mat img = cv::imread(im.path.string(), cv::IMREAD_COLOR);
+    ASSERT_EQ(img.cols, im.camera.width());
+    const Eigen::Vector3d local_center = im.camera.center() - world.offset;
+    for (int k = 0; k < 3000; ++k) {
+      const int c = col(rng), r = row(rng);
+      // Away from walls and crown edges: a flat 5x5 neighbourhood.
+      double spread = 0;
+      for (int dr = -2; dr <= 2; ++dr)
+        for (int dc = -2; dc <= 2; ++dc)
+          spread = std::max(spread, std::abs(dsm.at(c + dc, r + dr) - dsm.at(c, r)) * 1.0);
+      if (spread > 0.3) continue;
+      const Eigen::Vector2d xy = dsm.CellCenter(c, r);
+      const Eigen::Vector3d world_pt(xy.x(), xy.y(), dsm.at(c, r));
+      const Eigen::Vector2d uv = im.camera.Project(world_pt);
+      if (!im.camera.InImage(uv, 3)) continue;
+      // Visible: the first hit from the camera is the point itself.
+      const Eigen::Vector3d local = world_pt - world.offset;
+      const sim::Hit hit = world.scene.Intersect(local_center, (local - local_center).normalized());
+      if (!hit.valid || (hit.point - local).norm() > 2 * world.scene.cell()) continue;
+      const sim::Hit top = world.scene.TopAt(local.x(), local.y());
+      if (top.cls == sim::SurfaceClass::kWater) continue;
+      const double expect =
+          sim::EncodeChannel(world.scene.Shade(top)[1], gains.at(im.name));  // green
+      const int u = static_cast<int>(std::lround(uv.x())),
+                v = static_cast<int>(std::lround(uv.y()));
+      predicted.push_back(expect);
+      rendered.push_back(img.at<cv::Vec3b>(v, u)[1]);
+      shifted.push_back(img.at<cv::Vec3b>(v + 3, u + 3)[1]);
+    }
+  }
+  ASSERT_GE(predicted.size(), 1000u);
+  auto median_abs_diff = [&](const std::vector<double>& values) {
+    std::vector<double> d;
+    for (size_t i = 0; i < predicted.size(); ++i) d.push_back(std::abs(predicted[i] - values[i]));
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    return d[d.size() / 2];
+  };
+  const double r_at = Pearson(predicted, rendered), r_off = Pearson(predicted, shifted);
+  const double d_at = median_abs_diff(rendered), d_off = median_abs_diff(shifted);
+  std::cout << "[ sim ] " << predicted.size() << " points: correlation " << r_at
+            << ", median |difference| " << d_at << " grey levels; 3 px off: " << r_off << ", "
+            << d_off << "\n";
+  // A pixel averages 2x2 rays over its footprint while the prediction is a
+  // point sample, and there is sensor noise: close, not equal.
+  EXPECT_GT(r_at, 0.95);
+  EXPECT_LT(d_at, 4.0);
+  // Three pixels off, the texture no longer matches (the shading and the
+  // class colours still correlate).
+  EXPECT_GT(d_off, 3 * d_at);
+  EXPECT_LT(r_off, r_at - 0.05);
+}
+
+TEST(Simulate, TruthFilesAreValidAndAgree) {
+  const fs::path dir = test::ScratchDir();
+  const SimulateSummary s = Simulate(Tiny(dir));
+  const GeoRaster dsm = ReadGeoRaster(dir / "truth" / "dsm.tif");
+  EXPECT_NE(dsm.crs.find("32632"), std::string::npos);
+  // UTM-like coordinates, so float32 mistakes show.
+  EXPECT_GT(dsm.origin_x, 4.9e5);
+  EXPECT_GT(dsm.origin_y, 5.39e6);
+  const LasCloud las = ReadLas(dir / "truth" / "lidar.las");
+  EXPECT_EQ(static_cast<long>(las.points.size()), s.lidar_points);
+  EXPECT_FALSE(las.crs_wkt.empty());
+  ASSERT_GT(las.points.size(), 10000u);
+  // Ground returns lie on the DSM (2 cm vertical noise, 5 cm horizontal on
+  // gentle slopes); the density is about what the README promises.
+  std::vector<double> dz;
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+  for (const PointRecord& p : las.points) {
+    xmin = std::min(xmin, p.x), xmax = std::max(xmax, p.x), ymin = std::min(ymin, p.y),
+    ymax = std::max(ymax, p.y);
+    if (p.classification != 2) continue;
+    const int c = static_cast<int>((p.x - dsm.origin_x) / dsm.cell_size);
+    const int r = static_cast<int>((dsm.origin_y - p.y) / dsm.cell_size);
+    if (c < 1 || r < 1 || c >= dsm.width - 1 || r >= dsm.height - 1) continue;
+    dz.push_back(std::abs(p.z - dsm.at(c, r)));
+  }
+  ASSERT_GT(dz.size(), 1000u);
+  std::nth_element(dz.begin(), dz.begin() + dz.size() / 2, dz.end());
+  EXPECT_LT(dz[dz.size() / 2], 0.05);
+  const double density = las.points.size() / ((xmax - xmin) * (ymax - ymin));
+  EXPECT_GT(density, 1.0);
+  EXPECT_LT(density, 4.0 * 2.5);  // strips overlap
+}
+
+TEST(Simulate, AngleFlagsChangeTheFileNotTheCameras) {
+  const fs::path dir = test::ScratchDir();
+  SimulateOptions base = Tiny(dir / "base", 0.25);
+  Simulate(base);
+  const Block ref = ReadBlock(dir / "base" / "block.yaml");
+  for (const char* order : {"omega-phi-kappa", "phi-omega-kappa"}) {
+    for (const char* unit : {"deg", "gon", "rad"}) {
+      SimulateOptions o = Tiny(dir / (std::string(order) + unit), 0.25);
+      o.angles = order;
+      o.units = unit;
+      Simulate(o);
+      const std::string yaml = Slurp(o.out / "block.yaml");
+      EXPECT_NE(yaml.find(std::string("angles: ") + order), std::string::npos);
+      EXPECT_NE(yaml.find(std::string("units: ") + unit), std::string::npos);
+      const Block b = ReadBlock(o.out / "block.yaml");
+      ASSERT_EQ(b.images.size(), ref.images.size());
+      for (size_t i = 0; i < b.images.size(); ++i) {
+        EXPECT_LT(
+            (b.images[i].camera.rotation() - ref.images[i].camera.rotation()).cwiseAbs().maxCoeff(),
+            1e-9)
+            << order << " " << unit;
+      }
+    }
+  }
+}
+
+TEST(Simulate, PresetsDescribeThePapersBlocks) {
+  for (const std::string& name : SimulatePresetNames()) {
+    SimulateOptions o;
+    o.preset = name;
+    o.out = "unused";
+    o.scale = 0.05;  // plans only; nothing is rendered here
+    EXPECT_TRUE(o.Check()) << name;
+  }
+  SimulateOptions campus;
+  campus.preset = "campus";
+  campus.out = "unused";
+  campus.scale = 0.02;
+  const SimulatedWorld w = BuildWorld(campus);
+  EXPECT_EQ(w.images.size(), 67u);
+  EXPECT_EQ(w.strips, 4);
+  int per_strip[4] = {0, 0, 0, 0};
+  for (const PlannedImage& im : w.images) ++per_strip[im.strip];
+  EXPECT_EQ(per_strip[0], 16);
+  EXPECT_EQ(per_strip[1], 17);
+  EXPECT_EQ(per_strip[2], 18);
+  EXPECT_EQ(per_strip[3], 16);
+}
+
+TEST(Simulate, BadOptionsAreRejected) {
+  SimulateOptions o = Tiny(test::ScratchDir());
+  o.preset = "moon";
+  try {
+    Simulate(o);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown preset 'moon'"), std::string::npos) << e.what();
+  }
+  o = Tiny(test::ScratchDir());
+  o.scale = 0;
+  EXPECT_THROW(Simulate(o), Error);
+  o = Tiny(test::ScratchDir());
+  o.units = "grad-ish";
+  EXPECT_THROW(Simulate(o), Error);
+  EXPECT_FALSE(o.Check());
+}
+
+}  // namespace
+}  // namespace sapmvs

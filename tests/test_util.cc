@@ -1,0 +1,214 @@
+#include "test_util.h"
+
+#include "sapmvs/error.h"
+
+#include <unistd.h>
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace sapmvs::test {
+
+std::filesystem::path TestDir() { return SAPMVS_TEST_DIR; }
+
+std::filesystem::path SharedDir() {
+  if (const char* env = std::getenv("SAPMVS_SHARED_DIR"); env && *env) return env;
+  return std::filesystem::weakly_canonical(SAPMVS_SHARED_DIR);
+}
+
+std::filesystem::path ScratchDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  // The pid keeps two runs of the suite (e.g. two build trees) apart.
+  std::string name = "sapmvs_test_" + std::to_string(::getpid());
+  if (info) name += std::string("_") + info->test_suite_name() + "_" + info->name();
+  for (char& c : name) {
+    if (c == '/') c = '_';
+  }
+  auto dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+void ExpectInputError(const std::function<void()>& fn, const std::string& file_name, int line,
+                      const std::string& text) {
+  try {
+    fn();
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::filesystem::path(e.file()).filename().string(), file_name) << e.what();
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+  }
+}
+
+std::vector<Eigen::Vector3d> ReadXyz(const std::filesystem::path& path, int stride) {
+  std::ifstream in(path);
+  std::vector<Eigen::Vector3d> out;
+  double x, y, z;
+  for (long i = 0; in >> x >> y >> z; ++i) {
+    if (i % stride == 0) out.emplace_back(x, y, z);
+  }
+  return out;
+}
+
+namespace {
+
+cv::Mat Grey(const cv::Mat& bgr) {
+  cv::Mat g, f;
+  cv::cvtColor(bgr, g, cv::COLOR_BGR2GRAY);
+  g.convertTo(f, CV_32F);
+  return f;
+}
+
+double Bilinear(const cv::Mat& g, double x, double y) {
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= g.cols || y0 + 1 >= g.rows) return std::nan("");
+  const double fx = x - x0, fy = y - y0;
+  return (1 - fy) * ((1 - fx) * g.at<float>(y0, x0) + fx * g.at<float>(y0, x0 + 1)) +
+         fy * ((1 - fx) * g.at<float>(y0 + 1, x0) + fx * g.at<float>(y0 + 1, x0 + 1));
+}
+
+}  // namespace
+
+PairNcc MeanPairNcc(const LoadedImage& a, const LoadedImage& b,
+                    const std::vector<Eigen::Vector3d>& points, int half,
+                    const Eigen::Vector2d& shift_b) {
+  const cv::Mat ga = Grey(a.pixels), gb = Grey(b.pixels);
+  const int n = (2 * half + 1) * (2 * half + 1);
+  std::vector<double> wa(n), wb(n);
+  PairNcc r;
+  double sum = 0;
+  for (const Eigen::Vector3d& x : points) {
+    // The window is image a's pixel grid around the point, laid on the plane
+    // through the point facing camera a, and projected into b: images of
+    // opposite strips (kappa 0 and 180) are compared on the ground, not as
+    // rotated pixel windows.
+    const Eigen::Vector2d ua = a.camera.Project(x);
+    const double depth = a.camera.Depth(x);
+    if (!(depth > 0) || !b.camera.Project(x).allFinite()) continue;
+    bool ok = true;
+    for (int k = 0, i = -half; i <= half && ok; ++i) {
+      for (int j = -half; j <= half && ok; ++j, ++k) {
+        const Eigen::Vector2d pa = ua + Eigen::Vector2d(j, i);
+        const Eigen::Vector2d pb = b.camera.Project(a.camera.BackProject(pa, depth)) + shift_b;
+        wa[k] = Bilinear(ga, pa.x(), pa.y());
+        wb[k] = Bilinear(gb, pb.x(), pb.y());
+        ok = std::isfinite(wa[k]) && std::isfinite(wb[k]);
+      }
+    }
+    if (!ok) continue;
+    double ma = 0, mb = 0;
+    for (int k = 0; k < n; ++k) {
+      ma += wa[k];
+      mb += wb[k];
+    }
+    ma /= n;
+    mb /= n;
+    double saa = 0, sbb = 0, sab = 0;
+    for (int k = 0; k < n; ++k) {
+      saa += (wa[k] - ma) * (wa[k] - ma);
+      sbb += (wb[k] - mb) * (wb[k] - mb);
+      sab += (wa[k] - ma) * (wb[k] - mb);
+    }
+    // Flat windows (water, saturated roofs, undistortion's black border) have
+    // no defined correlation: a standard deviation under 2 grey levels.
+    if (saa < 4.0 * n || sbb < 4.0 * n) continue;
+    sum += sab / std::sqrt(saa * sbb);
+    ++r.points;
+  }
+  r.mean = r.points ? sum / r.points : 0;
+  return r;
+}
+
+BlockNcc MeasureBlockNcc(const std::vector<LoadedImage>& images,
+                         const std::vector<std::string>& names,
+                         const std::vector<Eigen::Vector3d>& points, int min_points) {
+  BlockNcc r;
+  double sum = 0;
+  for (size_t i = 0; i < images.size(); ++i) {
+    for (size_t j = i + 1; j < images.size(); ++j) {
+      const PairNcc at = MeanPairNcc(images[i], images[j], points);
+      if (at.points < min_points) continue;
+      const PairNcc off = MeanPairNcc(images[i], images[j], points, 5, {20, 0});
+      std::cout << "[ ncc ] " << names[i] << " / " << names[j] << ": " << at.mean << " over "
+                << at.points << " points; shifted 20 px: " << off.mean << "\n";
+      ++r.pairs;
+      sum += at.mean;
+      r.worst = std::min(r.worst, at.mean);
+      r.worst_margin = std::min(r.worst_margin, at.mean - off.mean);
+    }
+  }
+  r.mean = r.pairs ? sum / r.pairs : 0;
+  std::cout << "[ ncc ] mean over " << r.pairs << " pairs: " << r.mean << "\n";
+  return r;
+}
+
+namespace {
+
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+};
+
+const Features& SiftFeatures(const std::filesystem::path& path) {
+  static std::map<std::string, Features> cache;
+  auto it = cache.find(path.string());
+  if (it != cache.end()) return it->second;
+  const cv::Mat grey = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  Features f;
+  cv::SIFT::create(4000)->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
+  return cache.emplace(path.string(), std::move(f)).first->second;
+}
+
+}  // namespace
+
+const std::vector<Match>& SiftMatches(const std::filesystem::path& a,
+                                      const std::filesystem::path& b) {
+  static std::map<std::pair<std::string, std::string>, std::vector<Match>> cache;
+  const auto key = std::make_pair(a.string(), b.string());
+  auto it = cache.find(key);
+  if (it != cache.end()) return it->second;
+  const Features& fa = SiftFeatures(a);
+  const Features& fb = SiftFeatures(b);
+  cv::BFMatcher matcher(cv::NORM_L2);
+  std::vector<std::vector<cv::DMatch>> ab, ba;
+  matcher.knnMatch(fa.descriptors, fb.descriptors, ab, 2);
+  matcher.knnMatch(fb.descriptors, fa.descriptors, ba, 2);
+  std::vector<Match> out;
+  for (const auto& m : ab) {
+    if (m.size() < 2 || m[0].distance > 0.75f * m[1].distance) continue;
+    const auto& back = ba[m[0].trainIdx];
+    if (back.empty() || back[0].trainIdx != m[0].queryIdx) continue;
+    const cv::Point2f pa = fa.keypoints[m[0].queryIdx].pt, pb = fb.keypoints[m[0].trainIdx].pt;
+    out.push_back({{pa.x, pa.y}, {pb.x, pb.y}});
+  }
+  return cache.emplace(key, std::move(out)).first->second;
+}
+
+double MedianEpipolarDistance(const Camera& a, const Camera& b, const std::vector<Match>& matches) {
+  // F = K_b^-T [t]x R K_a^-1 with the pose of b relative to a.
+  const Eigen::Matrix3d r = b.rotation() * a.rotation().transpose();
+  const Eigen::Vector3d t = b.rotation() * (a.center() - b.center());
+  Eigen::Matrix3d tx;
+  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  const Eigen::Matrix3d f =
+      b.intrinsics().K().inverse().transpose() * tx * r * a.intrinsics().K().inverse();
+  std::vector<double> d;
+  for (const Match& m : matches) {
+    const Eigen::Vector3d line = f * m.a.homogeneous();
+    d.push_back(std::abs(line.dot(m.b.homogeneous())) / line.head<2>().norm());
+  }
+  if (d.empty()) return std::nan("");
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+}  // namespace sapmvs::test

@@ -1,0 +1,98 @@
+#pragma once
+// Helpers shared by the test files: where the checkout's test data and the
+// shared datasets lie, and a skip (never a silent pass) when data is missing.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sapmvs/camera.h"
+#include "sapmvs/image_io.h"
+
+namespace sapmvs::test {
+
+// tests/ in the source tree.
+std::filesystem::path TestDir();
+// ../shared beside the checkout (as in CI); SAPMVS_SHARED_DIR overrides it.
+std::filesystem::path SharedDir();
+// A fresh, empty directory under the system temp dir, unique per test.
+std::filesystem::path ScratchDir();
+
+// Runs `fn` and expects an InputError naming a file called `file_name` (the
+// last path component), `line`, and containing `text`.
+void ExpectInputError(const std::function<void()>& fn, const std::string& file_name, int line,
+                      const std::string& text);
+
+// A table row for readers' malformed-input tests: file content, and the line
+// and text the error must name.
+struct MalformedText {
+  std::string name;
+  std::string text;
+  int line;
+  std::string expect;
+};
+// Keeps ctest's discovered test names stable (no byte dumps).
+inline void PrintTo(const MalformedText& m, std::ostream* os) { *os << m.name; }
+
+// A fixture with a fresh scratch folder `dir_`, removed after the test.
+class ScratchTest : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = ScratchDir(); }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+// Reads `X Y Z` lines, keeping every `stride`-th point.
+std::vector<Eigen::Vector3d> ReadXyz(const std::filesystem::path& path, int stride = 1);
+
+// Photo-consistency of a pair: the mean NCC of (2 half + 1)^2 grey windows,
+// bilinearly sampled around the projections of `points` into both images
+// (image b's projections moved by `shift_b` pixels), over the points that
+// land inside both images on textured windows.
+struct PairNcc {
+  int points = 0;
+  double mean = 0;
+};
+PairNcc MeanPairNcc(const LoadedImage& a, const LoadedImage& b,
+                    const std::vector<Eigen::Vector3d>& points, int half = 5,
+                    const Eigen::Vector2d& shift_b = Eigen::Vector2d::Zero());
+
+// MeanPairNcc over every pair of `images` that shares at least `min_points`
+// points, also measured with image b shifted by 20 px as a control. Prints
+// one line per pair.
+struct BlockNcc {
+  int pairs = 0;
+  double mean = 0;          // mean over pairs
+  double worst = 1;         // lowest pair
+  double worst_margin = 1;  // lowest (pair NCC - shifted-control NCC)
+};
+BlockNcc MeasureBlockNcc(const std::vector<LoadedImage>& images,
+                         const std::vector<std::string>& names,
+                         const std::vector<Eigen::Vector3d>& points, int min_points = 200);
+
+// SIFT matches (Lowe ratio 0.75, mutual) between two image files, cached per
+// pair for the test binary's lifetime: several readers are checked against
+// the same real images.
+struct Match {
+  Eigen::Vector2d a, b;
+};
+const std::vector<Match>& SiftMatches(const std::filesystem::path& a,
+                                      const std::filesystem::path& b);
+
+// Median distance (px, in image b) of the matches to the epipolar lines of
+// the two cameras.
+double MedianEpipolarDistance(const Camera& a, const Camera& b, const std::vector<Match>& matches);
+
+}  // namespace sapmvs::test
+
+// Skips the current test, naming the missing path, when `path` does not exist.
+#define SAPMVS_REQUIRE_PATH(path)                                 \
+  do {                                                            \
+    if (!std::filesystem::exists(path)) {                         \
+      GTEST_SKIP() << "test data not found: " << (path).string(); \
+    }                                                             \
+  } while (0)
