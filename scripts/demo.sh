@@ -1,12 +1,20 @@
 #!/usr/bin/env bash
-# The demo: installs, builds, lists the OpenCL devices and describes a real
-# aerial block (the NGI block from ../shared). It grows with the pipeline.
+# The demo: installs, builds, then runs what the pipeline has so far end to end
+# on a built-in synthetic block (simulate -> info), and describes a real aerial
+# block (NGI, from ../shared) when it is there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
+out=out/demo
 echo
 echo "== sapmvs devices"
 ./build/sapmvs devices
+echo
+echo "== sapmvs simulate --preset tiny --out $out"
+./build/sapmvs simulate --preset tiny --out "$out"
+echo
+echo "== sapmvs info $out/block.yaml"
+./build/sapmvs info "$out/block.yaml"
 echo
 echo "== sapmvs info tests/blocks/ngi.yaml"
 if [ -d ../shared/datasets/orthority_ngi_odm/ngi ]; then

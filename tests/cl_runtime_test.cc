@@ -1,7 +1,6 @@
 #include "cl_runtime.h"
 
 #include <gtest/gtest.h>
-#include <CLI/CLI.hpp>
 
 #include <iostream>
 #include <set>
@@ -11,7 +10,6 @@
 
 #include "cl_error.h"
 #include "cl_test_fixture.h"
-#include "cli.h"
 #include "sapmvs/kernel_limits.h"
 
 namespace sapmvs {
@@ -20,7 +18,6 @@ namespace {
 using test::ScopedEnv;
 
 class ClRuntimeTest : public test::ClTest {};
-class DevicesCommandTest : public test::ClTest {};
 
 // Expects `statement` to throw `type` and binds its what() to `message`.
 #define EXPECT_THROW_WHAT(statement, type, message)           \
@@ -367,41 +364,6 @@ TEST_F(ClRuntimeTest, EventTimingNeedsProfilingQueue) {
   std::string what;
   EXPECT_THROW_WHAT(event.DeviceTimeNs(), Error, what);
   EXPECT_NE(what.find("DeviceOptions::profile"), std::string::npos) << what;
-}
-
-// --- `sapmvs devices` ---------------------------------------------------------
-
-// Runs `sapmvs <args>` in-process and returns stdout.
-std::string RunCli(const std::string& args) {
-  CLI::App app;
-  cli::GlobalFlags global;
-  cli::RegisterDevicesCommand(app, global);
-  std::ostringstream captured;
-  std::streambuf* old = std::cout.rdbuf(captured.rdbuf());
-  try {
-    app.parse(args, false);
-  } catch (...) {
-    std::cout.rdbuf(old);
-    throw;
-  }
-  std::cout.rdbuf(old);
-  return captured.str();
-}
-
-TEST_F(DevicesCommandTest, PrintsTableAndMarksChoice) {
-  ScopedEnv env("SAPMVS_DEVICE", std::nullopt);
-  const std::string table = RunCli("devices");
-  EXPECT_NE(table.find("index"), std::string::npos) << table;
-  EXPECT_NE(table.find("compute units"), std::string::npos) << table;
-  EXPECT_NE(table.find(context().device().name), std::string::npos) << table;
-  EXPECT_NE(table.find("* = default device"), std::string::npos) << table;
-  EXPECT_NE(table.find("\n*"), std::string::npos) << table;
-
-  const std::string index = std::to_string(context().device().index);
-  const std::string chosen = RunCli("devices --device " + index);
-  EXPECT_NE(chosen.find("\n*  " + index + " "), std::string::npos) << chosen;
-  EXPECT_NE(chosen.find("chosen by --device \"" + index + "\""), std::string::npos) << chosen;
-  EXPECT_THROW(RunCli("devices --device no-such-device-anywhere"), NoDeviceError);
 }
 
 }  // namespace

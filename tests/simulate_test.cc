@@ -163,7 +163,10 @@ TEST(Simulate, DsmPointsProjectOntoTheirShadedTexture) {
 
 TEST(Simulate, TruthFilesAreValidAndAgree) {
   const fs::path dir = test::ScratchDir();
-  const SimulateSummary s = Simulate(Tiny(dir));
+  SimulateOptions o = Tiny(dir);
+  o.xyz = true;
+  const SimulateSummary s = Simulate(o);
+  EXPECT_EQ(static_cast<long>(ReadXyz(dir / "truth" / "lidar.xyz").points.size()), s.lidar_points);
   const GeoRaster dsm = ReadGeoRaster(dir / "truth" / "dsm.tif");
   EXPECT_NE(dsm.crs.find("32632"), std::string::npos);
   // UTM-like coordinates, so float32 mistakes show.
@@ -241,6 +244,23 @@ TEST(Simulate, PresetsDescribeThePapersBlocks) {
   EXPECT_EQ(per_strip[1], 17);
   EXPECT_EQ(per_strip[2], 18);
   EXPECT_EQ(per_strip[3], 16);
+}
+
+TEST(Simulate, CrossStripFliesAcrossTheOthers) {
+  SimulateOptions o;
+  o.preset = "small";
+  o.out = "unused";
+  o.scale = 0.1;  // plans only
+  const SimulatedWorld plain = BuildWorld(o);
+  o.cross_strip = true;
+  const SimulatedWorld cross = BuildWorld(o);
+  EXPECT_EQ(cross.strips, plain.strips + 1);
+  ASSERT_GT(cross.images.size(), plain.images.size() + 1);
+  // The added images fly along +Y: kappa near 90 deg, x fixed, y increasing.
+  const PlannedImage& a = cross.images[plain.images.size()];
+  const PlannedImage& b = cross.images.back();
+  EXPECT_NEAR(a.kappa, 90, 3);
+  EXPECT_GT(b.center.y() - a.center.y(), 10 * std::abs(b.center.x() - a.center.x()));
 }
 
 TEST(Simulate, BadOptionsAreRejected) {

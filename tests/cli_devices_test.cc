@@ -1,0 +1,63 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "cl_runtime.h"
+#include "cli_test_util.h"
+#include "sapmvs/error.h"
+#include "test_util.h"
+
+namespace sapmvs {
+namespace {
+
+using test::RunCli;
+
+bool HaveOpenClDevice() {
+  try {
+    return !ListDevices().empty();
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+TEST(CliDevices, ListsDevicesAndMarksTheDefault) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto r = RunCli("devices", "env -u SAPMVS_DEVICE");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("compute units"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("* = default device"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\n*"), std::string::npos) << r.out;
+  for (const DeviceInfo& d : ListDevices()) EXPECT_NE(r.out.find(d.name), std::string::npos) << d.name;
+}
+
+TEST(CliDevices, ChoosesByIndexFlagOrEnvironment) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto flag = RunCli("devices --device 0");
+  ASSERT_EQ(flag.exit_code, 0) << flag.err;
+  EXPECT_NE(flag.out.find("\n*  0 "), std::string::npos) << flag.out;
+  EXPECT_NE(flag.out.find("chosen by --device \"0\""), std::string::npos) << flag.out;
+  const auto env = RunCli("devices", "SAPMVS_DEVICE=0");
+  ASSERT_EQ(env.exit_code, 0) << env.err;
+  EXPECT_NE(env.out.find("chosen by SAPMVS_DEVICE \"0\""), std::string::npos) << env.out;
+}
+
+TEST(CliDevices, UnmatchedDeviceIsOneLineAndExitCode2) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto r = RunCli("devices --device no-such-device-anywhere");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("no-such-device-anywhere"), std::string::npos) << r.err;
+}
+
+TEST(CliDevices, NoPlatformSaysHowToInstallPoclAndExits2) {
+  // An ICD loader with an empty vendor folder sees no platform at all.
+  const std::filesystem::path empty = test::ScratchDir();
+  const auto r = RunCli("devices", "OCL_ICD_VENDORS=" + empty.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("no OpenCL platform found"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pocl-opencl-icd"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace sapmvs
