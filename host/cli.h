@@ -18,5 +18,6 @@ struct GlobalFlags {
 void RegisterDevicesCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterInfoCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global);
+void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global);
 
 }  // namespace sapmvs::cli

@@ -27,7 +27,8 @@ TEST(CliDevices, ListsDevicesAndMarksTheDefault) {
   EXPECT_NE(r.out.find("compute units"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("* = default device"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\n*"), std::string::npos) << r.out;
-  for (const DeviceInfo& d : ListDevices()) EXPECT_NE(r.out.find(d.name), std::string::npos) << d.name;
+  for (const DeviceInfo& d : ListDevices())
+    EXPECT_NE(r.out.find(d.name), std::string::npos) << d.name;
 }
 
 TEST(CliDevices, ChoosesByIndexFlagOrEnvironment) {

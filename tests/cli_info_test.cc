@@ -89,7 +89,8 @@ TEST(Cli, HelpListsOnlyWorkingSubcommands) {
   EXPECT_NE(r.out.find("devices"), std::string::npos);
   EXPECT_NE(r.out.find("info"), std::string::npos);
   EXPECT_NE(r.out.find("simulate"), std::string::npos);
-  for (const char* later : {"run", "plan", "evaluate"}) {
+  EXPECT_NE(r.out.find("evaluate"), std::string::npos);
+  for (const char* later : {"run", "plan"}) {
     EXPECT_EQ(r.out.find(std::string("  ") + later + " "), std::string::npos) << later;
   }
 }

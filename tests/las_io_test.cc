@@ -25,10 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using Bytes = std::vector<uint8_t>;
 
-class LasIoTest : public test::ScratchTest {
- protected:
-  bool DirIsEmpty() const { return fs::directory_iterator(dir_) == fs::directory_iterator(); }
-};
+class LasIoTest : public test::ScratchTest {};
 
 // Little-endian field access, written independently of las_io.cc so that the
 // tests check the bytes against the specification, not against themselves.

@@ -29,8 +29,6 @@ class RasterIoTest : public test::ScratchTest {
     ScratchTest::SetUp();
     GDALAllRegister();
   }
-
-  bool DirIsEmpty() const { return fs::directory_iterator(dir_) == fs::directory_iterator(); }
 };
 
 struct DatasetCloser {

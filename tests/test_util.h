@@ -43,6 +43,9 @@ class ScratchTest : public ::testing::Test {
  protected:
   void SetUp() override { dir_ = ScratchDir(); }
   void TearDown() override { std::filesystem::remove_all(dir_); }
+  bool DirIsEmpty() const {
+    return std::filesystem::directory_iterator(dir_) == std::filesystem::directory_iterator();
+  }
   std::filesystem::path dir_;
 };
 

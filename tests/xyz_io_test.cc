@@ -25,7 +25,6 @@ class XyzIoTest : public test::ScratchTest {
     std::ofstream(path) << text;
     return path;
   }
-  bool DirIsEmpty() const { return fs::directory_iterator(dir_) == fs::directory_iterator(); }
 };
 
 // Expects ReadXyz(path) to fail at `line` with a message containing `expected`.
