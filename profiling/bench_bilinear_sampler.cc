@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_context.h"
 #include "bilinear_sampler.h"
 #include "cl_runtime.h"
 
@@ -44,25 +45,8 @@ Batch MakeBatch(int num_points) {
   return batch;
 }
 
-struct SharedContext {
-  std::unique_ptr<ClContext> context;
-  std::string error;
-};
-
-SharedContext& Shared() {
-  static SharedContext* shared = [] {
-    auto* s = new SharedContext;  // Leaked: see tests/cl_test_fixture.h.
-    try {
-      DeviceOptions options;
-      options.profile = true;
-      s->context = std::make_unique<ClContext>(options);
-    } catch (const std::exception& e) {
-      s->error = e.what();
-    }
-    return s;
-  }();
-  return *shared;
-}
+using bench::Shared;
+using bench::SharedContext;
 
 void SetRate(benchmark::State& state, int num_points) {
   state.counters["samples/s"] =

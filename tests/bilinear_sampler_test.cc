@@ -11,6 +11,7 @@
 
 #include "cl_test_fixture.h"
 #include "sapmvs/kernel_limits.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
@@ -23,21 +24,7 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kMaxPixel = 100.0f;  // Pixel values lie in [-kMaxPixel, kMaxPixel].
 
-// |actual - expected| <= abs_tol + rel_tol * |expected|, and NaN exactly where
-// the reference has NaN: the border policy must agree bit for bit.
-::testing::AssertionResult NearAbsRel(double actual, double expected, double abs_tol,
-                                      double rel_tol) {
-  if (std::isnan(expected) || std::isnan(actual)) {
-    if (std::isnan(expected) && std::isnan(actual)) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure()
-           << "NaN policy differs: got " << actual << ", reference " << expected;
-  }
-  const double error = std::abs(actual - expected);
-  const double tolerance = abs_tol + rel_tol * std::abs(expected);
-  if (error <= tolerance) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "got " << actual << ", reference " << expected
-                                       << ", error " << error << " > tolerance " << tolerance;
-}
+using test::NearAbsRel;
 
 // float32 bilinear interpolation rounds a handful of times on values up to
 // kMaxPixel; 4 epsilons of that is about 6x the worst error seen on PoCL and

@@ -37,6 +37,20 @@ std::filesystem::path ScratchDir() {
   return dir;
 }
 
+::testing::AssertionResult NearAbsRel(double actual, double expected, double abs_tol,
+                                      double rel_tol) {
+  if (std::isnan(expected) || std::isnan(actual)) {
+    if (std::isnan(expected) && std::isnan(actual)) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure()
+           << "NaN policy differs: got " << actual << ", reference " << expected;
+  }
+  const double error = std::abs(actual - expected);
+  const double tolerance = abs_tol + rel_tol * std::abs(expected);
+  if (error <= tolerance) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "got " << actual << ", reference " << expected
+                                       << ", error " << error << " > tolerance " << tolerance;
+}
+
 void ExpectInputError(const std::function<void()>& fn, const std::string& file_name, int line,
                       const std::string& text) {
   try {

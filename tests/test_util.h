@@ -22,6 +22,12 @@ std::filesystem::path SharedDir();
 // A fresh, empty directory under the system temp dir, unique per test.
 std::filesystem::path ScratchDir();
 
+// Kernel-versus-reference comparison: |actual - expected| <= abs_tol + rel_tol
+// * |expected|, and NaN exactly where the reference has NaN (border policies
+// must agree bit for bit).
+::testing::AssertionResult NearAbsRel(double actual, double expected, double abs_tol,
+                                      double rel_tol);
+
 // Runs `fn` and expects an InputError naming a file called `file_name` (the
 // last path component), `line`, and containing `text`.
 void ExpectInputError(const std::function<void()>& fn, const std::string& file_name, int line,

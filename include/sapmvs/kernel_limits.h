@@ -16,6 +16,17 @@ inline constexpr int kDefaultWorkGroupSize = 64;
 // per-work-item private arrays of the NCC kernels.
 inline constexpr int kMaxPatchSize = 21;
 
+// Side of the PMVS matching patch (μ in method.md 3.1, PMVS2's `wsize`), in
+// samples (odd). NccScorerOptions::patch_size defaults to it.
+inline constexpr int kDefaultPatchSize = 7;
+
+// Smallest per-sample variance (grey levels^2, images in 0..255) a sample
+// vector of the NCC kernels may have; below it the NCC is NaN. 1e-4 is a
+// standard deviation of 0.01 grey levels: far above the float32 rounding
+// noise of sampling a flat image (about 1e-10) and far below any real texture,
+// so only genuinely flat (or saturated) patches are rejected.
+inline constexpr float kNccMinVariance = 1e-4f;
+
 // Most views (reference + searches) one matching kernel call combines. Bounds
 // the per-work-item arrays of the multi-view kernels.
 inline constexpr int kMaxViews = 8;

@@ -1,0 +1,34 @@
+#pragma once
+// The OpenCL context shared by the benchmarks of one program: built once, with
+// profiling on, on the default device (or SAPMVS_DEVICE). A benchmark that
+// finds `error` set skips with it.
+
+#include <exception>
+#include <memory>
+#include <string>
+
+#include "cl_runtime.h"
+
+namespace sapmvs::bench {
+
+struct SharedContext {
+  std::unique_ptr<ClContext> context;
+  std::string error;
+};
+
+inline SharedContext& Shared() {
+  static SharedContext* shared = [] {
+    auto* s = new SharedContext;  // Leaked: see tests/cl_test_fixture.h.
+    try {
+      DeviceOptions options;
+      options.profile = true;
+      s->context = std::make_unique<ClContext>(options);
+    } catch (const std::exception& e) {
+      s->error = e.what();
+    }
+    return s;
+  }();
+  return *shared;
+}
+
+}  // namespace sapmvs::bench

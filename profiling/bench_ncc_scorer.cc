@@ -1,0 +1,146 @@
+// Throughput of the ncc_score kernel against its double-precision reference on
+// a synthetic batch: 4 random textured 640x480 images, one nadir-ish camera
+// each over a ground plane, patches under random reference pixels, each paired
+// with the three other images. The device comes from SAPMVS_DEVICE (default
+// device otherwise), e.g.
+//   SAPMVS_DEVICE=pocl ./build/profiling/bench_ncc_scorer --benchmark_counters_tabular=true
+// "pairs/s" counts (patch, view) scores; "ncc_samples/s" counts the 2 μ²
+// bilinear samples behind each. Kernel runs use wall time for the whole
+// Score() round trip (batch upload, kernel, read-back: what the matcher pays);
+// the DeviceTime variant the kernel's profiling timestamps only.
+
+#include <benchmark/benchmark.h>
+
+#include <exception>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "bench_context.h"
+#include "cl_runtime.h"
+#include "ncc_scorer.h"
+
+namespace sapmvs {
+namespace {
+
+constexpr int kWidth = 640;
+constexpr int kHeight = 480;
+constexpr int kNumImages = 4;
+
+struct Batch {
+  std::vector<std::vector<float>> pixels;
+  NccGroup group;
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+};
+
+// Smoothed noise images (texture without rendering a scene: the rate does not
+// depend on the NCC values) and cameras 40 m above a plane, 4 m apart.
+Batch MakeBatch(int num_pairs) {
+  Batch batch;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> value(0.0f, 255.0f);
+  const Intrinsics intrinsics = Intrinsics::FromPixels(600, 600, 319.5, 239.5, kWidth, kHeight);
+  Eigen::Matrix3d r_wc;
+  r_wc << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // Looking straight down.
+  std::vector<Camera> cameras;
+  for (int i = 0; i < kNumImages; ++i) {
+    std::vector<float> image(static_cast<size_t>(kWidth) * kHeight);
+    for (float& p : image) p = value(rng);
+    for (size_t k = 1; k < image.size(); ++k) image[k] = 0.5f * (image[k] + image[k - 1]);
+    batch.pixels.push_back(std::move(image));
+    cameras.emplace_back(intrinsics, r_wc, Eigen::Vector3d(4.0 * (i % 2), 4.0 * (i / 2), 40.0));
+    batch.group.images.push_back({batch.pixels.back().data(), {kWidth, kHeight, kWidth}});
+    batch.group.cameras.push_back(MakeNccCamera(cameras.back()));
+  }
+  std::uniform_real_distribution<double> u(0.0, kWidth - 1.0);
+  std::uniform_real_distribution<double> v(0.0, kHeight - 1.0);
+  const int views_per_patch = kNumImages - 1;
+  for (int p = 0; p * views_per_patch < num_pairs; ++p) {
+    const int reference = p % kNumImages;
+    const Camera& camera = cameras[reference];
+    const Eigen::Vector3d d = camera.Ray(Eigen::Vector2d(u(rng), v(rng)));
+    const Eigen::Vector3d ground = camera.center() - (camera.center().z() / d.z()) * d;
+    batch.patches.push_back(MakeNccPatch(ground, Eigen::Vector3d::UnitZ(), reference));
+    for (int view = 0; view < kNumImages && static_cast<int>(batch.pairs.size()) < num_pairs;
+         ++view) {
+      if (view != reference) batch.pairs.push_back({p, view});
+    }
+  }
+  return batch;
+}
+
+using bench::Shared;
+using bench::SharedContext;
+
+void SetRates(benchmark::State& state, int num_pairs, int patch_size) {
+  const double pairs = static_cast<double>(num_pairs) * static_cast<double>(state.iterations());
+  state.counters["pairs/s"] = benchmark::Counter(pairs, benchmark::Counter::kIsRate);
+  state.counters["ncc_samples/s"] =
+      benchmark::Counter(pairs * 2.0 * patch_size * patch_size, benchmark::Counter::kIsRate);
+}
+
+void RunKernel(benchmark::State& state, bool device_time) {
+  SharedContext& shared = Shared();
+  if (!shared.context) {
+    state.SkipWithError(shared.error.c_str());
+    return;
+  }
+  const int num_pairs = static_cast<int>(state.range(0));
+  NccScorerOptions options;
+  options.patch_size = static_cast<int>(state.range(1));
+  const Batch batch = MakeBatch(num_pairs);
+  NccScorer scorer(*shared.context, options);
+  scorer.SetGroup(batch.group);              // Once: the images stay on the device.
+  scorer.Score(batch.patches, batch.pairs);  // Warm-up.
+  for (auto _ : state) {
+    ClEvent event;
+    std::vector<float> scores = scorer.Score(batch.patches, batch.pairs, &event);
+    benchmark::DoNotOptimize(scores.data());
+    if (device_time) state.SetIterationTime(static_cast<double>(event.DeviceTimeNs()) * 1e-9);
+  }
+  SetRates(state, num_pairs, options.patch_size);
+}
+
+void BM_NccKernel(benchmark::State& state) { RunKernel(state, false); }
+void BM_NccKernelDeviceTime(benchmark::State& state) { RunKernel(state, true); }
+
+void BM_NccReference(benchmark::State& state) {
+  const int num_pairs = static_cast<int>(state.range(0));
+  const int patch_size = static_cast<int>(state.range(1));
+  const Batch batch = MakeBatch(num_pairs);
+  for (auto _ : state) {
+    std::vector<double> scores =
+        NccScoreReference(batch.group, batch.patches, batch.pairs, patch_size);
+    benchmark::DoNotOptimize(scores.data());
+  }
+  SetRates(state, num_pairs, patch_size);
+}
+
+BENCHMARK(BM_NccKernel)
+    ->ArgsProduct({{20000}, {7, 11}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NccKernelDeviceTime)
+    ->ArgsProduct({{20000}, {7, 11}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NccReference)
+    ->ArgsProduct({{20000}, {7, 11}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace sapmvs
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  const sapmvs::SharedContext& shared = sapmvs::Shared();
+  benchmark::AddCustomContext("opencl_device", shared.context ? shared.context->device().Describe()
+                                                              : "none (" + shared.error + ")");
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,470 @@
+#include "ncc_scorer.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cl_test_fixture.h"
+#include "kernel_source.h"
+#include "sapmvs/kernel_limits.h"
+#include "test_util.h"
+
+namespace sapmvs {
+namespace {
+
+using test::ClTest;
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+using test::NearAbsRel;
+
+// The NCC divides centred float32 sums of up to 121 bilinear samples whose
+// positions come from float32 projections (about 1e-5 px off the double ones
+// on these scenes). The worst error seen on PoCL is printed by each run and
+// was 2.7e-6; the tolerance leaves over 30x room for FMA contraction and other
+// devices' rounding while still catching a wrong sample or axis (which moves
+// the NCC by 1e-2 or more).
+constexpr double kAbsTol = 1e-4;
+constexpr double kRelTol = 1e-4;
+// Within this distance (pixels) of an image's valid region a sample's float32
+// position may fall on the other side of the border than its double one, so
+// the NaN decision may legitimately differ; the test counts such pairs.
+constexpr double kBorderAmbiguity = 1e-3;
+
+// A textured ground plane z = 0 (local frame) seen by pinhole cameras looking
+// down from about 40 m with random tilts: the images are rendered by casting
+// each pixel's ray onto the plane, so the true plane is photo-consistent.
+struct PlaneScene {
+  std::vector<std::vector<float>> pixels;
+  std::vector<Camera> cameras;  // Local frame.
+  NccGroup group;
+  // Texture: a sum of 16 plane waves (wavelengths 0.8 to 3 m, i.e. about 3 to
+  // 11 pixels), non-periodic enough that a shifted patch does not match.
+  std::vector<Eigen::Vector4d> waves;  // (kx, ky, phase, amplitude).
+
+  double Texture(double x, double y) const {
+    double value = 128.0;
+    for (const Eigen::Vector4d& w : waves) value += w[3] * std::sin(w[0] * x + w[1] * y + w[2]);
+    return value;
+  }
+};
+
+PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  PlaneScene scene;
+  constexpr double kPi = 3.14159265358979323846;
+  for (int k = 0; k < 16; ++k) {
+    const double wavelength = 0.8 + 2.2 * (0.5 + 0.5 * unit(rng));
+    const double angle = kPi * unit(rng);
+    const double kmag = 2.0 * kPi / wavelength;
+    scene.waves.emplace_back(kmag * std::cos(angle), kmag * std::sin(angle), kPi * unit(rng),
+                             8.0 + 4.0 * unit(rng));
+  }
+  // Georeferenced-looking world coordinates, translated to a local origin as
+  // the block does; the texture and patches live in the local frame.
+  const Eigen::Vector3d origin(500000.0, 6000000.0, 100.0);
+  const Intrinsics intrinsics = Intrinsics::FromPixels(150.0, 152.0, 0.5 * (width - 1) + 2.0,
+                                                       0.5 * (height - 1) - 1.5, width, height);
+  for (int i = 0; i < num_images; ++i) {
+    const Eigen::Vector3d center(6.0 * unit(rng), 6.0 * unit(rng), 40.0 + 3.0 * unit(rng));
+    // Nadir (camera x = world x, y = -world y, z down), then a yaw and a tilt
+    // of up to about 12 degrees.
+    Eigen::Matrix3d r_cw;
+    r_cw.col(0) = Eigen::Vector3d(1, 0, 0);
+    r_cw.col(1) = Eigen::Vector3d(0, -1, 0);
+    r_cw.col(2) = Eigen::Vector3d(0, 0, -1);
+    const Eigen::Matrix3d tilt = (Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitX()) *
+                                  Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(kPi * unit(rng), Eigen::Vector3d::UnitZ()))
+                                     .toRotationMatrix();
+    const Camera world(intrinsics, (tilt * r_cw).transpose(), center + origin);
+    scene.cameras.push_back(world.Translated(origin));
+  }
+  for (const Camera& camera : scene.cameras) {
+    std::vector<float> image(static_cast<size_t>(width) * height);
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const Eigen::Vector3d d = camera.Ray(Eigen::Vector2d(u, v));
+        const Eigen::Vector3d x = camera.center() - (camera.center().z() / d.z()) * d;
+        image[static_cast<size_t>(v) * width + u] = static_cast<float>(scene.Texture(x.x(), x.y()));
+      }
+    }
+    scene.pixels.push_back(std::move(image));
+  }
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    scene.group.images.push_back({scene.pixels[i].data(), {width, height, width}});
+    scene.group.cameras.push_back(MakeNccCamera(scene.cameras[i]));
+  }
+  return scene;
+}
+
+// Ground point seen at pixel `uv` of `camera`.
+Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv) {
+  const Eigen::Vector3d d = camera.Ray(uv);
+  return camera.center() - (camera.center().z() / d.z()) * d;
+}
+
+// Random patches: centres on or near the ground under random reference pixels
+// (a band beyond every border included, so both NaN outcomes occur), normals
+// tilted up to about 30 degrees; every patch paired with every image.
+void RandomBatch(const PlaneScene& scene, int num_patches, uint32_t seed,
+                 std::vector<NccPatch>* patches, std::vector<NccPair>* pairs) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const int num_images = static_cast<int>(scene.cameras.size());
+  for (int p = 0; p < num_patches; ++p) {
+    const int reference = static_cast<int>(rng() % num_images);
+    const Camera& camera = scene.cameras[reference];
+    const double w = camera.width();
+    const double h = camera.height();
+    // Half the patches within 8 px of a border, where the NaN policy decides.
+    Eigen::Vector2d uv(0.5 * (w - 1) * (1 + unit(rng)), 0.5 * (h - 1) * (1 + unit(rng)));
+    if (p % 2 == 0) {
+      const double band = 8.0 * unit(rng);
+      switch (rng() % 4) {
+        case 0:
+          uv.x() = band;
+          break;
+        case 1:
+          uv.x() = w - 1 + band;
+          break;
+        case 2:
+          uv.y() = band;
+          break;
+        default:
+          uv.y() = h - 1 + band;
+          break;
+      }
+    }
+    const Eigen::Vector3d normal =
+        Eigen::Vector3d(0.5 * unit(rng), 0.5 * unit(rng), 1.0).normalized();
+    const Eigen::Vector3d center = GroundAt(camera, uv) + 0.3 * unit(rng) * normal;
+    patches->push_back(MakeNccPatch(center, normal, reference));
+    for (int v = 0; v < num_images; ++v) pairs->push_back({p, v});
+  }
+}
+
+struct Comparison {
+  double worst_error = 0.0;
+  int num_valid = 0;
+  int num_nan = 0;
+  int num_ambiguous = 0;
+};
+
+// Kernel vs reference, pair by pair; ambiguous border cases only counted.
+Comparison CompareWithReference(const std::vector<float>& scores,
+                                const std::vector<double>& expected,
+                                const std::vector<double>& margin) {
+  Comparison result;
+  EXPECT_EQ(scores.size(), expected.size());
+  for (size_t i = 0; i < std::min(scores.size(), expected.size()); ++i) {
+    if (std::abs(margin[i]) < kBorderAmbiguity &&
+        std::isnan(scores[i]) != std::isnan(expected[i])) {
+      ++result.num_ambiguous;
+      continue;
+    }
+    EXPECT_TRUE(NearAbsRel(scores[i], expected[i], kAbsTol, kRelTol)) << "pair " << i;
+    if (std::isnan(expected[i])) {
+      ++result.num_nan;
+    } else {
+      ++result.num_valid;
+      result.worst_error = std::max(result.worst_error, std::abs(scores[i] - expected[i]));
+    }
+  }
+  return result;
+}
+
+struct ScoreCase {
+  int patch_size;
+  int width;
+  int height;
+  uint32_t seed;
+};
+
+void PrintTo(const ScoreCase& c, std::ostream* out) {
+  *out << "patch " << c.patch_size << ", " << c.width << "x" << c.height << ", seed " << c.seed;
+}
+
+std::string CaseName(const ::testing::TestParamInfo<ScoreCase>& info) {
+  return "patch" + std::to_string(info.param.patch_size) + "_" + std::to_string(info.param.width) +
+         "x" + std::to_string(info.param.height);
+}
+
+class NccScorerCaseTest : public ClTest, public ::testing::WithParamInterface<ScoreCase> {};
+
+TEST_P(NccScorerCaseTest, MatchesDoubleReference) {
+  const ScoreCase& c = GetParam();
+  const PlaneScene scene = MakePlaneScene(4, c.width, c.height, c.seed);
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  RandomBatch(scene, 400, c.seed + 1, &patches, &pairs);
+
+  NccScorerOptions options;
+  options.patch_size = c.patch_size;
+  NccScorer scorer(context(), options);
+  scorer.SetGroup(scene.group);
+  const std::vector<float> scores = scorer.Score(patches, pairs);
+  std::vector<double> margin;
+  const std::vector<double> expected =
+      NccScoreReference(scene.group, patches, pairs, c.patch_size, &margin);
+  const Comparison result = CompareWithReference(scores, expected, margin);
+  std::printf("[ NCC      ] patch %d: %d valid, %d NaN, %d ambiguous, worst |error| %.3g\n",
+              c.patch_size, result.num_valid, result.num_nan, result.num_ambiguous,
+              result.worst_error);
+  // Both outcomes exercised, and border ambiguity stays rare.
+  EXPECT_GT(result.num_valid, static_cast<int>(pairs.size()) / 4);
+  EXPECT_GT(result.num_nan, static_cast<int>(pairs.size()) / 10);
+  EXPECT_LE(result.num_ambiguous, static_cast<int>(pairs.size()) / 200);
+}
+
+INSTANTIATE_TEST_SUITE_P(NccSizes, NccScorerCaseTest,
+                         ::testing::Values(ScoreCase{5, 161, 123, 31}, ScoreCase{7, 161, 123, 32},
+                                           ScoreCase{11, 161, 123, 33}, ScoreCase{7, 97, 211, 34},
+                                           ScoreCase{11, 255, 101, 35}),
+                         CaseName);
+
+class NccScorerTest : public ClTest {};
+
+// The geometry check: the true patch is photo-consistent in every view, the
+// same patch slid along the reference ray is not.
+TEST_F(NccScorerTest, TruePatchScoresHighAndOffsetPatchLow) {
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 41);
+  const Camera& ref = scene.cameras[0];
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  const Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  std::vector<Eigen::Vector3d> truths;
+  for (const Eigen::Vector2d& uv : {Eigen::Vector2d(80, 61), Eigen::Vector2d(72, 56),
+                                    Eigen::Vector2d(88, 66), Eigen::Vector2d(84, 57)}) {
+    const Eigen::Vector3d truth = GroundAt(ref, uv);
+    truths.push_back(truth);
+    const Eigen::Vector3d ray = (truth - ref.center()).normalized();
+    for (double offset : {0.0, 8.0}) {
+      const int p = static_cast<int>(patches.size());
+      patches.push_back(MakeNccPatch(truth + offset * ray, normal, 0));
+      for (int v = 1; v < 4; ++v) pairs.push_back({p, v});
+    }
+  }
+  NccScorer scorer(context());
+  scorer.SetGroup(scene.group);
+  const std::vector<float> scores = scorer.Score(patches, pairs);
+  std::vector<double> margin;
+  const std::vector<double> expected =
+      NccScoreReference(scene.group, patches, pairs, kDefaultPatchSize, &margin);
+  int num_shifted = 0;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    EXPECT_TRUE(NearAbsRel(scores[i], expected[i], kAbsTol, kRelTol)) << "pair " << i;
+    ASSERT_FALSE(std::isnan(scores[i])) << "pair " << i << " should be inside every image";
+    const NccPatch& patch = patches[pairs[i].patch];
+    if (pairs[i].patch % 2 == 0) {
+      EXPECT_GT(scores[i], 0.95) << "true patch, pair " << i;
+      continue;
+    }
+    // How far the wrong depth moves the patch centre in this view, in pixels.
+    const Camera& view = scene.cameras[pairs[i].view];
+    const Eigen::Vector3d wrong(patch.center.s[0], patch.center.s[1], patch.center.s[2]);
+    const Eigen::Vector3d& truth = truths[pairs[i].patch / 2];
+    const double shift = (view.Project(wrong) - view.Project(truth)).norm();
+    std::printf("[ NCC      ] pair %zu: true patch %.3f, offset patch %.3f, shift %.2f px\n", i,
+                scores[i - 3], scores[i], shift);
+    if (shift >= 3.0) {
+      ++num_shifted;
+      EXPECT_LT(scores[i], 0.6) << "patch off the surface along the ray, pair " << i;
+      EXPECT_LT(scores[i], scores[i - 3] - 0.3) << "pair " << i;
+    }
+  }
+  EXPECT_GE(num_shifted, 4);
+  // The reference pairs with itself: NCC 1.
+  const std::vector<float> self = scorer.Score(patches, {{0, 0}});
+  EXPECT_NEAR(self[0], 1.0f, 1e-5f);
+}
+
+TEST_F(NccScorerTest, FlatImageAndBehindCameraGiveNaN) {
+  PlaneScene scene = MakePlaneScene(3, 61, 47, 51);
+  // Image 2: image 0's camera over a flat image, so only the variance rule
+  // can void its pairs.
+  std::fill(scene.pixels[2].begin(), scene.pixels[2].end(), 200.0f);
+  scene.group.cameras[2] = scene.group.cameras[0];
+  const Eigen::Vector3d truth = GroundAt(scene.cameras[0], Eigen::Vector2d(30, 23));
+  std::vector<NccPatch> patches = {
+      MakeNccPatch(truth, Eigen::Vector3d::UnitZ(), 0),
+      // Far above every camera: in front of none of them.
+      MakeNccPatch(truth + Eigen::Vector3d(0, 0, 100), Eigen::Vector3d::UnitZ(), 0),
+      // A plane perpendicular to the reference x axis: no in-plane grid.
+      MakeNccPatch(truth, scene.cameras[0].rotation().row(0).transpose(), 0)};
+  const std::vector<NccPair> pairs = {{0, 0}, {0, 2}, {1, 0}, {2, 0}};
+  NccScorer scorer(context());
+  scorer.SetGroup(scene.group);
+  const std::vector<float> scores = scorer.Score(patches, pairs);
+  const std::vector<double> expected =
+      NccScoreReference(scene.group, patches, pairs, kDefaultPatchSize);
+  EXPECT_FALSE(std::isnan(scores[0]));
+  for (size_t i = 1; i < pairs.size(); ++i) {
+    EXPECT_TRUE(std::isnan(scores[i])) << "pair " << i;
+    EXPECT_TRUE(std::isnan(expected[i])) << "pair " << i;
+  }
+}
+
+TEST_F(NccScorerTest, WorkGroupSizeDoesNotChangeResults) {
+  const PlaneScene scene = MakePlaneScene(3, 97, 61, 61);
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  RandomBatch(scene, 77, 62, &patches, &pairs);
+  NccScorer base(context());
+  base.SetGroup(scene.group);
+  const std::vector<float> reference = base.Score(patches, pairs);
+  for (int group : {1, 7, 32}) {
+    NccScorerOptions options;
+    options.work_group_size = group;
+    NccScorer scorer(context(), options);
+    scorer.SetGroup(scene.group);
+    const std::vector<float> scores = scorer.Score(patches, pairs);
+    for (size_t i = 0; i < scores.size(); ++i) {
+      ASSERT_TRUE(scores[i] == reference[i] || (std::isnan(scores[i]) && std::isnan(reference[i])))
+          << "work-group size " << group << ", pair " << i;
+    }
+  }
+}
+
+// The copy of bilinear_at in ncc_score.cl must stay the one in
+// bilinear_sample.cl: the text is compared, and the copy (through the packed
+// image table) is checked against BilinearSampleReference.
+std::string FunctionText(const std::string& source, const std::string& signature) {
+  const size_t begin = source.find(signature);
+  if (begin == std::string::npos) return "";
+  const size_t end = source.find("\n}\n", begin);
+  return end == std::string::npos ? "" : source.substr(begin, end + 3 - begin);
+}
+
+TEST(NccBilinearCopyTest, SourceIsIdenticalToBilinearSample) {
+  const std::string signature = "float bilinear_at(";
+  const std::string original = FunctionText(EmbeddedKernelSource("bilinear_sample.cl"), signature);
+  ASSERT_FALSE(original.empty());
+  EXPECT_EQ(FunctionText(EmbeddedKernelSource("ncc_score.cl"), signature), original);
+}
+
+TEST_F(NccScorerTest, CopiedBilinearMatchesBilinearReference) {
+  // Two images with row padding (NaN, so reading it shows), the second at a
+  // non-zero offset in the packed buffer.
+  std::mt19937 rng(71);
+  std::uniform_real_distribution<float> value(0.0f, 255.0f);
+  const ImageLayout layouts[2] = {{13, 7, 16}, {9, 11, 10}};
+  std::vector<std::vector<float>> pixels;
+  NccGroup group;
+  for (const ImageLayout& layout : layouts) {
+    std::vector<float> image(layout.RequiredElements(), kNaN);
+    for (int r = 0; r < layout.height; ++r) {
+      for (int c = 0; c < layout.width; ++c)
+        image[static_cast<size_t>(r) * layout.row_pitch + c] = value(rng);
+    }
+    pixels.push_back(std::move(image));
+  }
+  const Camera camera(Intrinsics::FromPixels(10, 10, 4, 3, 13, 7), Eigen::Matrix3d::Identity(),
+                      Eigen::Vector3d::Zero());
+  for (int i = 0; i < 2; ++i) {
+    group.images.push_back({pixels[i].data(), layouts[i]});
+    group.cameras.push_back(MakeNccCamera(camera));
+  }
+  NccScorer scorer(context());
+  scorer.SetGroup(group);
+  for (int i = 0; i < 2; ++i) {
+    const float w = static_cast<float>(layouts[i].width - 1);
+    const float h = static_cast<float>(layouts[i].height - 1);
+    std::uniform_real_distribution<float> x(-1.0f, w + 1.0f);
+    std::uniform_real_distribution<float> y(-1.0f, h + 1.0f);
+    std::vector<Eigen::Vector2f> points = {{0, 0},         {w, h},      {w, 0},        {0, h},
+                                           {w + 1e-3f, 0}, {0, -1e-3f}, {0.5f * w, h}, {kNaN, 1}};
+    for (int k = 0; k < 300; ++k) points.emplace_back(x(rng), y(rng));
+    const std::vector<float> values = scorer.ProbeSamples(i, points);
+    int num_nan = 0;
+    for (size_t k = 0; k < points.size(); ++k) {
+      const double expected =
+          BilinearSampleReference(group.images[i], points[k].x(), points[k].y());
+      EXPECT_TRUE(NearAbsRel(values[k], expected, 4 * 255 * 1.2e-7, 4 * 1.2e-7))
+          << "image " << i << " at (" << points[k].x() << ", " << points[k].y() << ")";
+      num_nan += std::isnan(expected) ? 1 : 0;
+    }
+    EXPECT_GT(num_nan, 0);
+  }
+}
+
+TEST_F(NccScorerTest, RejectsBadInputBeforeEnqueue) {
+  for (int size : {1, 2, 4, kMaxPatchSize + 2}) {
+    NccScorerOptions options;
+    options.patch_size = size;
+    EXPECT_FALSE(options.Check()) << size;
+    EXPECT_THROW(NccScorer(context(), options), Error) << size;
+  }
+  NccScorerOptions options;
+  EXPECT_TRUE(options.Check());
+  options.work_group_size = 0;
+  EXPECT_FALSE(options.Check());
+  EXPECT_THROW(NccScorer(context(), options), Error);
+
+  PlaneScene scene = MakePlaneScene(2, 31, 21, 81);
+  NccScorer scorer(context());
+  const Eigen::Vector3d ground = GroundAt(scene.cameras[0], Eigen::Vector2d(15, 10));
+  const std::vector<NccPatch> good = {MakeNccPatch(ground, Eigen::Vector3d::UnitZ(), 0)};
+  EXPECT_THROW(scorer.Score(good, {{0, 1}}), Error);  // No group yet.
+
+  const auto expect_error = [&](const auto& call, const std::string& text) {
+    try {
+      call();
+      ADD_FAILURE() << "expected Error containing " << text;
+    } catch (const ClError& e) {
+      ADD_FAILURE() << "the driver saw the bad input: " << e.what();
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  NccGroup bad = scene.group;
+  bad.cameras.pop_back();
+  expect_error([&] { scorer.SetGroup(bad); }, "2 images but 1 cameras");
+  bad = scene.group;
+  bad.images[1].data = nullptr;
+  expect_error([&] { scorer.SetGroup(bad); }, "image 1 has no pixel data");
+  bad = scene.group;
+  bad.cameras[1].p[0].s[3] = kNaN;
+  expect_error([&] { scorer.SetGroup(bad); }, "image 1: camera has a non-finite entry");
+  bad = scene.group;
+  bad.cameras[0].center.s[3] = 0.0f;
+  expect_error([&] { scorer.SetGroup(bad); }, "focal length");
+  expect_error([&] { scorer.SetGroup(NccGroup()); }, "no images");
+
+  scorer.SetGroup(scene.group);
+  EXPECT_EQ(scorer.Score(good, {}).size(), 0u);
+  expect_error([&] { scorer.Score(good, {{1, 1}}); }, "pair 0: patch 1");
+  expect_error([&] { scorer.Score(good, {{0, 0}, {0, 2}}); }, "pair 1: view 2");
+  expect_error([&] { scorer.Score(good, {{0, -1}}); }, "view -1");
+  std::vector<NccPatch> patches = good;
+  patches[0].reference = 5;
+  expect_error([&] { scorer.Score(patches, {{0, 1}}); }, "patch 0: reference image 5");
+  patches = good;
+  patches[0].center.s[1] = std::numeric_limits<float>::infinity();
+  expect_error([&] { scorer.Score(patches, {{0, 1}}); }, "non-finite");
+  patches = good;
+  patches[0].normal.s[2] = 0.9f;
+  expect_error([&] { scorer.Score(patches, {{0, 1}}); }, "normal has length");
+  expect_error([&] { scorer.ProbeSamples(2, {{0, 0}}); }, "probe image 2");
+
+  // The reference applies the same checks.
+  EXPECT_THROW(NccScoreReference(scene.group, good, {{0, 3}}, 7), Error);
+  EXPECT_THROW(NccScoreReference(scene.group, good, {{0, 1}}, 6), Error);
+
+  Camera distorted = scene.cameras[0];
+  Intrinsics intrinsics = distorted.intrinsics();
+  intrinsics.distortion.k1 = 0.1;
+  EXPECT_THROW(MakeNccCamera(distorted.WithIntrinsics(intrinsics)), Error);
+}
+
+}  // namespace
+}  // namespace sapmvs
