@@ -113,34 +113,29 @@ std::vector<std::string> SimulatePresetNames() {
   return names;
 }
 
-bool SimulateOptions::Check() const {
-  // The CLI reports the first problem through Simulate(); here only a verdict.
+std::string SimulateOptions::Problem() const {
   try {
     sim::FindPreset(preset);
     if (!angles.empty()) ParseAngleOrder(angles);
     if (!units.empty()) ParseAngleUnit(units);
-  } catch (const Error&) {
-    return false;
+  } catch (const Error& e) {
+    return e.what();
   }
-  return !out.empty() && scale > 0 && scale <= 4 && supersampling >= 2 && supersampling <= 8 &&
-         noise >= 0 && noise <= 50 && exposure <= 0.5;
+  if (out.empty()) return "no output folder given (--out DIR)";
+  if (!(scale > 0 && scale <= 4)) return "--scale " + std::to_string(scale) + " is outside (0, 4]";
+  if (supersampling < 2 || supersampling > 8) {
+    return "--supersampling " + std::to_string(supersampling) + " is outside 2..8";
+  }
+  if (!(noise >= 0 && noise <= 50))
+    return "--noise " + std::to_string(noise) + " is outside 0..50 grey levels";
+  if (!(exposure <= 0.5)) return "--exposure " + std::to_string(exposure) + " is above 0.5";
+  return "";
 }
 
 SimulatedWorld BuildWorld(const SimulateOptions& o) {
+  if (const std::string problem = o.Problem(); !problem.empty())
+    throw Error("simulate: " + problem);
   const sim::Preset preset = sim::FindPreset(o.preset);
-  if (o.out.empty()) throw Error("simulate: no output folder given (--out DIR)");
-  if (!(o.scale > 0 && o.scale <= 4)) {
-    throw Error("simulate: --scale " + std::to_string(o.scale) + " is outside (0, 4]");
-  }
-  if (o.supersampling < 2 || o.supersampling > 8) {
-    throw Error("simulate: --supersampling " + std::to_string(o.supersampling) +
-                " is outside 2..8");
-  }
-  if (!(o.noise >= 0 && o.noise <= 50))
-    throw Error("simulate: --noise must be 0 to 50 grey levels");
-  if (!(o.exposure <= 0.5)) throw Error("simulate: --exposure must be at most 0.5");
-  if (!o.angles.empty()) ParseAngleOrder(o.angles);
-  if (!o.units.empty()) ParseAngleUnit(o.units);
   const sim::CameraSpec camera = sim::ScaledCamera(preset.camera, o.scale);
   const double exposure = o.exposure >= 0 ? o.exposure : preset.flight.exposure;
   const sim::FlightPlan plan = sim::PlanFlight(preset, camera, o.cross_strip, exposure, o.seed);

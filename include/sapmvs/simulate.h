@@ -30,7 +30,9 @@ struct SimulateOptions {
   bool xyz = false;          // also write truth/lidar.xyz
   bool quiet = false;        // no progress bar
 
-  bool Check() const;
+  // Empty when the options are usable, else one line naming the bad value.
+  std::string Problem() const;
+  bool Check() const { return Problem().empty(); }
 };
 
 std::vector<std::string> SimulatePresetNames();
