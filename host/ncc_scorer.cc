@@ -177,7 +177,7 @@ NccScorer::NccScorer(ClContext& context, const NccScorerOptions& options)
   probe_kernel_ = program.Kernel(kProbeKernel);
 }
 
-void NccScorer::SetGroup(const NccGroup& group) {
+NccDeviceGroup UploadNccGroup(ClContext& context, const NccGroup& group) {
   group.Validate();
   // Pack every image into one buffer: one argument however many images, and
   // the int4 table addresses them (offsets in elements).
@@ -195,26 +195,32 @@ void NccScorer::SetGroup(const NccGroup& group) {
     table[i].s[3] = layout.row_pitch;
     total += layout.RequiredElements();
   }
-  ClBuffer images(context_, total * sizeof(float), CL_MEM_READ_ONLY);
+  ClBuffer images(context, total * sizeof(float), CL_MEM_READ_ONLY);
   for (size_t i = 0; i < group.images.size(); ++i) {
     images.Write(group.images[i].data, group.images[i].layout.RequiredElements() * sizeof(float),
                  static_cast<size_t>(table[i].s[0]) * sizeof(float));
   }
-  ClBuffer image_table(context_, table.size() * sizeof(cl_int4), CL_MEM_READ_ONLY);
+  ClBuffer image_table(context, table.size() * sizeof(cl_int4), CL_MEM_READ_ONLY);
   image_table.WriteVector(table);
-  ClBuffer cameras(context_, group.cameras.size() * sizeof(NccCamera), CL_MEM_READ_ONLY);
+  ClBuffer cameras(context, group.cameras.size() * sizeof(NccCamera), CL_MEM_READ_ONLY);
   cameras.WriteVector(group.cameras);
-  // Swap in only once everything is uploaded, so a failure keeps the old group.
-  images_ = std::move(images);
-  image_table_ = std::move(image_table);
-  cameras_ = std::move(cameras);
-  num_images_ = static_cast<int>(group.images.size());
+  NccDeviceGroup out;
+  out.images = std::move(images);
+  out.image_table = std::move(image_table);
+  out.cameras = std::move(cameras);
+  out.num_images = static_cast<int>(group.images.size());
+  return out;
+}
+
+void NccScorer::SetGroup(const NccGroup& group) {
+  // Assigned only once everything is uploaded, so a failure keeps the old group.
+  group_ = UploadNccGroup(context_, group);
 }
 
 std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
                                     const std::vector<NccPair>& pairs, ClEvent* event) {
-  if (num_images_ == 0) throw Error("NccScorer::Score called before SetGroup");
-  ValidateNccBatch(patches, pairs, num_images_);
+  if (group_.num_images == 0) throw Error("NccScorer::Score called before SetGroup");
+  ValidateNccBatch(patches, pairs, group_.num_images);
   if (pairs.empty()) return {};
 
   ClBuffer patch_buffer(context_, patches.size() * sizeof(NccPatch), CL_MEM_READ_ONLY);
@@ -224,7 +230,8 @@ std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
   ClBuffer score_buffer(context_, pairs.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
   const cl_int num_pairs = static_cast<cl_int>(pairs.size());
-  score_kernel_.SetArgs(images_, image_table_, cameras_, cl_int{num_images_}, patch_buffer,
+  score_kernel_.SetArgs(group_.images, group_.image_table, group_.cameras,
+                        cl_int{group_.num_images}, patch_buffer,
                         static_cast<cl_int>(patches.size()), pair_buffer, num_pairs, score_buffer);
   ClEvent launched = context_.Enqueue(score_kernel_, NDRange(pairs.size()),
                                       NDRange(static_cast<size_t>(options_.work_group_size)));
@@ -236,9 +243,9 @@ std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
 }
 
 std::vector<float> NccScorer::ProbeSamples(int image, const std::vector<Eigen::Vector2f>& points) {
-  if (image < 0 || image >= num_images_) {
+  if (image < 0 || image >= group_.num_images) {
     throw Error("NCC probe image " + std::to_string(image) + " is not in the group of " +
-                std::to_string(num_images_) + " images");
+                std::to_string(group_.num_images) + " images");
   }
   if (points.size() > static_cast<size_t>(INT_MAX)) throw Error("NCC probe batch too large");
   if (points.empty()) return {};
@@ -246,7 +253,7 @@ std::vector<float> NccScorer::ProbeSamples(int image, const std::vector<Eigen::V
   ClBuffer point_buffer(context_, points.size() * sizeof(Eigen::Vector2f), CL_MEM_READ_ONLY);
   point_buffer.Write(points.data(), points.size() * sizeof(Eigen::Vector2f));
   ClBuffer value_buffer(context_, points.size() * sizeof(float), CL_MEM_WRITE_ONLY);
-  probe_kernel_.SetArgs(images_, image_table_, cl_int{image}, point_buffer,
+  probe_kernel_.SetArgs(group_.images, group_.image_table, cl_int{image}, point_buffer,
                         static_cast<cl_int>(points.size()), value_buffer);
   context_.Enqueue(probe_kernel_, NDRange(points.size()),
                    NDRange(static_cast<size_t>(options_.work_group_size)));

@@ -96,6 +96,21 @@ struct NccGroup {
   void Validate() const;
 };
 
+// A group resident on the device: every image packed into one buffer (one
+// kernel argument however many images) with an int4 (offset in elements,
+// width, height, row pitch) table, and the cameras. The scorer and the
+// refiner each keep one for the group they work on.
+struct NccDeviceGroup {
+  ClBuffer images;
+  ClBuffer image_table;
+  ClBuffer cameras;
+  int num_images = 0;
+};
+
+// Validates `group` and uploads it; throws before touching the device when the
+// group is invalid or its pixels exceed the kernels' int offsets.
+NccDeviceGroup UploadNccGroup(ClContext& context, const NccGroup& group);
+
 class NccScorer {
  public:
   // Builds the kernel (or takes it from the context's program cache). Throws
@@ -105,7 +120,7 @@ class NccScorer {
   // Validates and uploads the group; its images then stay on the device until
   // the next SetGroup. Blocking.
   void SetGroup(const NccGroup& group);
-  int num_images() const { return num_images_; }
+  int num_images() const { return group_.num_images; }
 
   // scores[i] = NCC of pairs[i] (see NccPair), or NaN. Validates every index
   // and every patch (finite, unit normal within 1e-3) before enqueueing and
@@ -125,10 +140,7 @@ class NccScorer {
   NccScorerOptions options_;
   ClKernel score_kernel_;
   ClKernel probe_kernel_;
-  int num_images_ = 0;
-  ClBuffer images_;
-  ClBuffer image_table_;
-  ClBuffer cameras_;
+  NccDeviceGroup group_;
 };
 
 // Throws Error naming the first pair or patch the kernel must not see.

@@ -1,0 +1,330 @@
+// Batched patch refinement (issue 4, "Kernels"): one work-item per patch
+// optimises the patch's depth along its reference ray and the two angles of
+// its normal to maximise the mean NCC over its views, all iterations
+// in-kernel. See kernels/README.md ("patch_refine.cl") for the data layout and
+// the search; PatchRefineReference (host/patch_refiner.cc) is the
+// double-precision twin and must keep exactly the same parameterisation, step
+// schedule and tie rules.
+//
+// The NCC primitives below (NccCamera, NccPatch, bilinear_at, sample_image,
+// sample_projection, ncc_of) are copied verbatim from ncc_score.cl, because
+// the kernel embedding has no #include; tests/patch_refiner_test.cc compares
+// the text. The grid geometry of patch_views_ncc is that of the ncc_score
+// kernel body.
+//
+// Build options (the host passes all of them; see sapmvs/kernel_limits.h):
+//   WORK_GROUP_SIZE   work-items per group; the launch must use exactly this.
+//   PATCH_SIZE        μ, samples per side of the patch grid (odd).
+//   NCC_MIN_VARIANCE  smallest per-sample variance of a sample vector.
+//   MAX_VIEWS         most views per patch (bounds the private arrays).
+
+#ifndef WORK_GROUP_SIZE
+#define WORK_GROUP_SIZE 64
+#endif
+#ifndef PATCH_SIZE
+#define PATCH_SIZE 7
+#endif
+#ifndef NCC_MIN_VARIANCE
+#define NCC_MIN_VARIANCE 1e-4f
+#endif
+#ifndef MAX_VIEWS
+#define MAX_VIEWS 8
+#endif
+
+#define NCC_NUM_SAMPLES (PATCH_SIZE * PATCH_SIZE)
+
+// Same guard as in ncc_score.cl. Host twin: kNccMinAxisLength.
+#define NCC_MIN_AXIS_LENGTH 1e-3f
+
+// One image's camera (host: NccCamera, 96 bytes).
+typedef struct {
+  float4 p0, p1, p2;  // Rows of the 3x4 projection matrix K [R | t], local frame.
+  float4 x_axis;      // Camera x axis in the world (row 0 of R_wc); w = 0.
+  float4 y_axis;      // Camera y axis in the world (row 1 of R_wc); w = 0.
+  float4 center;      // xyz: projection centre (local); w: mean focal length, pixels.
+} NccCamera;
+
+// One patch (host: NccPatch, 48 bytes).
+typedef struct {
+  float4 center;  // xyz: patch centre c (local); w ignored.
+  float4 normal;  // xyz: unit normal n; w ignored.
+  int reference;  // Index of the reference image R(p).
+  int reserved0, reserved1, reserved2;
+} NccPatch;
+
+// One refined patch (host: RefinedPatchOut, 48 bytes).
+typedef struct {
+  float4 center;  // xyz: refined centre; w: mean NCC over the views (NaN: none valid).
+  float4 normal;  // xyz: refined unit normal; w: 0.
+  float4 params;  // x: depth offset along the ray from the start, in footprints;
+                  // y: yaw, z: pitch (radians); w: accepted moves.
+} RefinedPatchOut;
+
+// Copied verbatim from bilinear_sample.cl, because the kernel embedding has no
+// #include: keep the two identical (tests/ncc_scorer_test.cc compares the
+// text). Bilinear value of `image` at (x, y); NaN unless 0 <= x <= width - 1
+// and 0 <= y <= height - 1.
+float bilinear_at(__global const float* image, int width, int height, int row_pitch, float x,
+                  float y) {
+  // Written negated so that NaN coordinates, which compare false, are rejected.
+  if (!(x >= 0.0f && y >= 0.0f && x <= (float)(width - 1) && y <= (float)(height - 1))) {
+    return NAN;
+  }
+  // Clamping the cell keeps x == width - 1 from reading column `width`; the
+  // fraction then becomes 1 (or 0 for a 1-pixel-wide image, where x1 == x0).
+  const int x0 = min((int)x, max(width - 2, 0));
+  const int y0 = min((int)y, max(height - 2, 0));
+  const int x1 = min(x0 + 1, width - 1);
+  const int y1 = min(y0 + 1, height - 1);
+  const float fx = x - (float)x0;
+  const float fy = y - (float)y0;
+  __global const float* row0 = image + (size_t)y0 * (size_t)row_pitch;
+  __global const float* row1 = image + (size_t)y1 * (size_t)row_pitch;
+  // (1 - f) * a + f * b rather than a + f * (b - a): exact at f = 0 and f = 1,
+  // so pixel centres reproduce the pixel bit for bit.
+  const float top = (1.0f - fx) * row0[x0] + fx * row0[x1];
+  const float bottom = (1.0f - fx) * row1[x0] + fx * row1[x1];
+  return (1.0f - fy) * top + fy * bottom;
+}
+
+// Image `index` of the packed buffer sampled at (x, y). `table[index]` is
+// (offset in elements, width, height, row pitch).
+float sample_image(__global const float* images, __global const int4* table, int index, float x,
+                   float y) {
+  const int4 t = table[index];
+  return bilinear_at(images + t.x, t.y, t.z, t.w, x, y);
+}
+
+// `camera` sampled at the projection of the local point `X`; NaN when `X` is
+// not strictly in front of the camera or projects outside the image.
+float sample_projection(__global const float* images, __global const int4* table, int index,
+                        const NccCamera camera, float3 X) {
+  const float4 h = (float4)(X, 1.0f);
+  const float w = dot(camera.p2, h);
+  if (!(w > 0.0f)) {
+    return NAN;
+  }
+  return sample_image(images, table, index, dot(camera.p0, h) / w, dot(camera.p1, h) / w);
+}
+
+// The NCC of `a` and `b` (NCC_NUM_SAMPLES values each), two-pass so that
+// bright images do not lose the variance to cancellation; NaN when either
+// per-sample variance is below NCC_MIN_VARIANCE.
+float ncc_of(const float* a, const float* b) {
+  float mean_a = 0.0f;
+  float mean_b = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    mean_a += a[k];
+    mean_b += b[k];
+  }
+  mean_a /= (float)NCC_NUM_SAMPLES;
+  mean_b /= (float)NCC_NUM_SAMPLES;
+  float saa = 0.0f;
+  float sbb = 0.0f;
+  float sab = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    const float da = a[k] - mean_a;
+    const float db = b[k] - mean_b;
+    saa += da * da;
+    sbb += db * db;
+    sab += da * db;
+  }
+  const float min_sum = NCC_MIN_VARIANCE * (float)NCC_NUM_SAMPLES;
+  if (!(saa >= min_sum && sbb >= min_sum)) {
+    return NAN;
+  }
+  return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+}
+
+// The patch frame: e_z points from the initial centre towards the reference
+// camera, e_x is the reference x axis made orthogonal to e_z, e_y = e_z x e_x.
+// The normal of (yaw, pitch) is
+//   cos(pitch) sin(yaw) e_x + sin(pitch) e_y + cos(pitch) cos(yaw) e_z.
+float3 normal_of(float3 e_x, float3 e_y, float3 e_z, float yaw, float pitch) {
+  const float cp = cos(pitch);
+  return (cp * sin(yaw)) * e_x + sin(pitch) * e_y + (cp * cos(yaw)) * e_z;
+}
+
+// Mean NCC of the patch (c, n) in `ref` against each of its `num_views` views
+// (NCCs into `nccs`); NaN when any view's NCC is NaN (ncc_score's rules).
+float patch_views_ncc(__global const float* images, __global const int4* table,
+                      __global const NccCamera* cameras, int reference, const int* views,
+                      int num_views, float3 c, float3 n, float* nccs) {
+  for (int v = 0; v < num_views; ++v) {
+    nccs[v] = NAN;
+  }
+  const NccCamera ref = cameras[reference];
+  const float depth = dot(ref.p2, (float4)(c, 1.0f));
+  if (!(depth > 0.0f)) {
+    return NAN;
+  }
+  const float step = depth / ref.center.w;
+  const float3 x_proj = ref.x_axis.xyz - dot(ref.x_axis.xyz, n) * n;
+  const float x_length = length(x_proj);
+  if (!(x_length >= NCC_MIN_AXIS_LENGTH)) {
+    return NAN;
+  }
+  const float3 x_dir = x_proj / x_length;
+  float3 y_dir = cross(n, x_dir);
+  if (dot(y_dir, ref.y_axis.xyz) < 0.0f) {
+    y_dir = -y_dir;
+  }
+  const float3 dx = step * x_dir;
+  const float3 dy = step * y_dir;
+  const int half_size = PATCH_SIZE / 2;
+
+  // The reference samples once, shared by every view.
+  float a[NCC_NUM_SAMPLES];
+  for (int r = 0; r < PATCH_SIZE; ++r) {
+    const float3 row = c + (float)(r - half_size) * dy;
+    for (int col = 0; col < PATCH_SIZE; ++col) {
+      const float3 X = row + (float)(col - half_size) * dx;
+      const float va = sample_projection(images, table, reference, ref, X);
+      if (isnan(va)) {
+        return NAN;
+      }
+      a[r * PATCH_SIZE + col] = va;
+    }
+  }
+  float sum = 0.0f;
+  bool all_valid = true;
+  float b[NCC_NUM_SAMPLES];
+  for (int v = 0; v < num_views; ++v) {
+    const NccCamera view = cameras[views[v]];
+    bool valid = true;
+    for (int r = 0; r < PATCH_SIZE && valid; ++r) {
+      const float3 row = c + (float)(r - half_size) * dy;
+      for (int col = 0; col < PATCH_SIZE; ++col) {
+        const float3 X = row + (float)(col - half_size) * dx;
+        const float vb = sample_projection(images, table, views[v], view, X);
+        if (isnan(vb)) {
+          valid = false;
+          break;
+        }
+        b[r * PATCH_SIZE + col] = vb;
+      }
+    }
+    nccs[v] = valid ? ncc_of(a, b) : NAN;
+    if (isnan(nccs[v])) {
+      all_valid = false;
+    } else {
+      sum += nccs[v];
+    }
+  }
+  return all_valid ? sum / (float)num_views : NAN;
+}
+
+// True when `score` beats `best`: valid, and best is NaN or strictly lower.
+bool improves(float score, float best) { return !isnan(score) && (isnan(best) || score > best); }
+
+// Refines patches[i] for i < num_patches against its views
+// view_indices[view_offsets[i] .. view_offsets[i + 1]) (CSR; the host checks
+// 1 to MAX_VIEWS views, all in range and none the reference).
+//
+// Parameters: t (distance from the reference centre along the ray through the
+// initial centre), yaw, pitch (see normal_of). Initial steps: depth_step
+// footprints (depth / f at the initial centre) for t, angle_step radians for
+// both angles. Each of `iterations` rounds scores the 6 candidates
+// p +- step_k e_k (in the order +t, -t, +yaw, -yaw, +pitch, -pitch), moves to
+// the best if it strictly beats the current score, else halves every step.
+// A candidate with |yaw| or |pitch| above max_angle is invalid (NaN).
+__kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch_refine(
+    __global const float* restrict images, __global const int4* restrict image_table,
+    __global const NccCamera* restrict cameras, const int num_images,
+    __global const NccPatch* restrict patches, const int num_patches,
+    __global const int* restrict view_offsets, __global const int* restrict view_indices,
+    const int iterations, const float depth_step, const float angle_step, const float max_angle,
+    __global RefinedPatchOut* restrict results, __global float* restrict view_scores) {
+  const int i = (int)get_global_id(0);
+  if (i >= num_patches) {
+    return;
+  }
+  const NccPatch patch = patches[i];
+  const int first = view_offsets[i];
+  const int num_views = view_offsets[i + 1] - first;
+  RefinedPatchOut out;
+  out.center = (float4)(patch.center.xyz, NAN);
+  out.normal = (float4)(patch.normal.xyz, 0.0f);
+  out.params = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
+  // Guards only: the host rejects all of these before enqueueing.
+  if (patch.reference < 0 || patch.reference >= num_images || num_views < 1 ||
+      num_views > MAX_VIEWS) {
+    results[i] = out;
+    return;
+  }
+  int views[MAX_VIEWS];
+  for (int v = 0; v < num_views; ++v) {
+    views[v] = view_indices[first + v];
+    if (views[v] < 0 || views[v] >= num_images) {
+      results[i] = out;
+      return;
+    }
+  }
+
+  const NccCamera ref = cameras[patch.reference];
+  const float3 origin = ref.center.xyz;
+  const float3 c0 = patch.center.xyz;
+  const float t0 = length(c0 - origin);
+  const float3 ray = (c0 - origin) / t0;
+  const float3 e_z = -ray;
+  const float3 e_x = normalize(ref.x_axis.xyz - dot(ref.x_axis.xyz, e_z) * e_z);
+  const float3 e_y = cross(e_z, e_x);
+  const float3 n0 = patch.normal.xyz;
+  const float footprint = dot(ref.p2, (float4)(c0, 1.0f)) / ref.center.w;
+
+  float p[3] = {t0, atan2(dot(n0, e_x), dot(n0, e_z)), asin(clamp(dot(n0, e_y), -1.0f, 1.0f))};
+  float step[3] = {depth_step * footprint, angle_step, angle_step};
+  float nccs[MAX_VIEWS];
+  float trial[MAX_VIEWS];
+  float best_nccs[MAX_VIEWS];
+  float score = NAN;
+  if (fabs(p[1]) <= max_angle && fabs(p[2]) <= max_angle) {
+    score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
+                            origin + p[0] * ray, normal_of(e_x, e_y, e_z, p[1], p[2]), nccs);
+  } else {
+    for (int v = 0; v < num_views; ++v) {
+      nccs[v] = NAN;
+    }
+  }
+  int moves = 0;
+  for (int it = 0; it < iterations; ++it) {
+    float best = score;
+    int best_k = -1;
+    for (int k = 0; k < 6; ++k) {
+      float q[3] = {p[0], p[1], p[2]};
+      q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
+      if (!(fabs(q[1]) <= max_angle && fabs(q[2]) <= max_angle)) {
+        continue;
+      }
+      const float s =
+          patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
+                          origin + q[0] * ray, normal_of(e_x, e_y, e_z, q[1], q[2]), trial);
+      if (improves(s, best)) {
+        best = s;
+        best_k = k;
+        for (int v = 0; v < num_views; ++v) {
+          best_nccs[v] = trial[v];
+        }
+      }
+    }
+    if (best_k >= 0) {
+      p[best_k / 2] += (best_k % 2 == 0) ? step[best_k / 2] : -step[best_k / 2];
+      score = best;
+      for (int v = 0; v < num_views; ++v) {
+        nccs[v] = best_nccs[v];
+      }
+      ++moves;
+    } else {
+      for (int k = 0; k < 3; ++k) {
+        step[k] *= 0.5f;
+      }
+    }
+  }
+  out.center = (float4)(origin + p[0] * ray, score);
+  out.normal = (float4)(normal_of(e_x, e_y, e_z, p[1], p[2]), 0.0f);
+  out.params = (float4)((p[0] - t0) / footprint, p[1], p[2], (float)moves);
+  results[i] = out;
+  for (int v = 0; v < num_views; ++v) {
+    view_scores[first + v] = nccs[v];
+  }
+}

@@ -1,0 +1,290 @@
+#include "patch_refiner.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cl_test_fixture.h"
+#include "kernel_source.h"
+#include "plane_scene.h"
+#include "sapmvs/error.h"
+#include "sapmvs/kernel_limits.h"
+
+namespace sapmvs {
+namespace {
+
+using test::ClTest;
+
+constexpr double kPiRad = 3.14159265358979323846;
+
+// Final mean NCC, kernel vs reference. Both run the same search; float32
+// scores differ from the double ones by about 1e-5 (ncc_scorer_test), which
+// can flip a near-tie late in the search and end on a neighbouring point of
+// the same optimum, so the tolerance is on the score, not bit-level.
+constexpr double kScoreTol = 2e-3;
+// Where every decision of the reference search had a margin above this, the
+// kernel must take the same path; its parameters must then agree to float
+// precision.
+constexpr double kSafeMargin = 1e-4;
+constexpr double kDepthTol = 1e-3;  // Footprints.
+constexpr double kAngleTol = 1e-4;  // Radians.
+
+using test::MakePlaneScene;
+using test::PlaneScene;
+
+using test::GroundAt;
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / kPiRad;
+}
+
+// Footprint (depth / f) of `camera` at `x`.
+double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
+  return (camera.rotation() * (x - camera.center())).z() / camera.intrinsics().MeanFocal();
+}
+
+// Patches on the ground under pixels near the centre of image 0, started
+// `depth_offsets` footprints off along the ray and `tilt_deg` off in normal
+// (about a horizontal axis that turns with the patch index).
+void PerturbedPatches(const PlaneScene& scene, int num_patches, double depth_offset,
+                      double tilt_deg, uint32_t seed, std::vector<NccPatch>* patches,
+                      std::vector<std::vector<int>>* views) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const Camera& ref = scene.cameras[0];
+  for (int p = 0; p < num_patches; ++p) {
+    const Eigen::Vector2d uv(0.5 * (ref.width() - 1) + 20.0 * unit(rng),
+                             0.5 * (ref.height() - 1) + 15.0 * unit(rng));
+    const Eigen::Vector3d truth = GroundAt(ref, uv);
+    const Eigen::Vector3d ray = (truth - ref.center()).normalized();
+    const double sign = (p % 2 == 0) ? 1.0 : -1.0;
+    const Eigen::Vector3d start = truth + sign * depth_offset * Footprint(ref, truth) * ray;
+    const double azimuth = 2.0 * kPiRad * p / num_patches;
+    const Eigen::Vector3d axis(std::cos(azimuth), std::sin(azimuth), 0.0);
+    const Eigen::Vector3d normal =
+        Eigen::AngleAxisd(tilt_deg * kPiRad / 180.0, axis) * Eigen::Vector3d::UnitZ();
+    patches->push_back(MakeNccPatch(start, normal, 0));
+    views->push_back({1, 2, 3});
+  }
+}
+
+struct RefComparison {
+  double worst_score_error = 0.0;
+  double worst_depth_error = 0.0;
+  double worst_angle_error = 0.0;
+  int same_path = 0;
+};
+
+RefComparison CompareWithReference(const std::vector<RefinedPatch>& got,
+                                   const std::vector<RefinedPatchReference>& expected) {
+  RefComparison c;
+  EXPECT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < std::min(got.size(), expected.size()); ++i) {
+    const RefinedPatch& g = got[i];
+    const RefinedPatchReference& e = expected[i];
+    EXPECT_EQ(std::isnan(g.score), std::isnan(e.score)) << "patch " << i;
+    if (std::isnan(e.score) || std::isnan(g.score)) continue;
+    EXPECT_NEAR(g.score, e.score, kScoreTol) << "patch " << i;
+    c.worst_score_error = std::max(c.worst_score_error, std::abs(g.score - e.score));
+    if (e.decision_margin > kSafeMargin) {
+      ++c.same_path;
+      EXPECT_EQ(g.moves, e.moves) << "patch " << i;
+      EXPECT_NEAR(g.depth_offset, e.depth_offset, kDepthTol) << "patch " << i;
+      EXPECT_NEAR(g.yaw, e.yaw, kAngleTol) << "patch " << i;
+      EXPECT_NEAR(g.pitch, e.pitch, kAngleTol) << "patch " << i;
+      c.worst_depth_error =
+          std::max(c.worst_depth_error, std::abs(g.depth_offset - e.depth_offset));
+      c.worst_angle_error =
+          std::max({c.worst_angle_error, std::abs(g.yaw - e.yaw), std::abs(g.pitch - e.pitch)});
+      EXPECT_EQ(g.view_scores.size(), e.view_scores.size());
+      for (size_t v = 0; v < std::min(g.view_scores.size(), e.view_scores.size()); ++v) {
+        EXPECT_NEAR(g.view_scores[v], e.view_scores[v], 1e-4) << "patch " << i << " view " << v;
+      }
+    }
+  }
+  return c;
+}
+
+TEST(PatchRefinerOptionsTest, CheckRejectsBadValues) {
+  EXPECT_TRUE(PatchRefinerOptions().Check());
+  auto bad = [](auto mutate) {
+    PatchRefinerOptions o;
+    mutate(o);
+    return !o.Check();
+  };
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.patch_size = 4; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.patch_size = kMaxPatchSize + 2; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.work_group_size = 0; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.iterations = -1; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.iterations = kMaxRefineIterations + 1; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.depth_step = 0.0; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.depth_step = std::nan(""); }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.angle_step_deg = 60.0; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.max_angle_deg = 90.0; }));
+}
+
+TEST(PatchRefineKernelTextTest, NccHelpersAreVerbatimCopies) {
+  const std::string ncc = EmbeddedKernelSource("ncc_score.cl");
+  const std::string refine = EmbeddedKernelSource("patch_refine.cl");
+  const std::string begin = "// Copied verbatim from bilinear_sample.cl";
+  const size_t a0 = ncc.find(begin);
+  const size_t a1 = ncc.find("// scores[i] = NCC of patch");
+  const size_t b0 = refine.find(begin);
+  const size_t b1 = refine.find("// The patch frame:");
+  ASSERT_NE(a0, std::string::npos);
+  ASSERT_NE(a1, std::string::npos);
+  ASSERT_NE(b0, std::string::npos);
+  ASSERT_NE(b1, std::string::npos);
+  EXPECT_EQ(ncc.substr(a0, a1 - a0), refine.substr(b0, b1 - b0));
+  // The struct typedefs too.
+  const std::string camera =
+      ncc.substr(ncc.find("typedef struct"), ncc.find("} NccPatch;") - ncc.find("typedef struct"));
+  EXPECT_NE(refine.find(camera), std::string::npos);
+}
+
+class PatchRefinerTest : public ClTest {};
+
+TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 12, 2.5, 15.0, 52, &patches, &views);
+  // 11x11: with 7x7 on this scene (baselines of about 6 m at 40 m) the mean
+  // NCC is nearly flat in the normal; the search then ends above the true
+  // plane's own score (0.996 to 0.999, limited by bilinear interpolation) but
+  // up to 5.2 degrees off its normal. 11x11 pins the normal to 2.4 degrees.
+  PatchRefinerOptions options;
+  options.patch_size = 11;
+  PatchRefiner refiner(context(), options);
+  refiner.SetGroup(scene.group);
+  const std::vector<RefinedPatch> refined = refiner.Refine(patches, views);
+  ASSERT_EQ(refined.size(), patches.size());
+  const Camera& ref = scene.cameras[0];
+  double worst_depth = 0.0;
+  double worst_angle = 0.0;
+  double lowest_score = 1.0;
+  for (size_t i = 0; i < refined.size(); ++i) {
+    const Eigen::Vector3d c(refined[i].patch.center.s[0], refined[i].patch.center.s[1],
+                            refined[i].patch.center.s[2]);
+    const Eigen::Vector3d n(refined[i].patch.normal.s[0], refined[i].patch.normal.s[1],
+                            refined[i].patch.normal.s[2]);
+    // Distance to the plane z = 0 along the reference ray, in footprints.
+    const Eigen::Vector3d ray = (c - ref.center()).normalized();
+    const double depth_error = std::abs(c.z() / ray.z()) / Footprint(ref, c);
+    const double angle_error = AngleDeg(n, Eigen::Vector3d::UnitZ());
+    EXPECT_LT(depth_error, 0.5) << "patch " << i;
+    EXPECT_LT(angle_error, 5.0) << "patch " << i;
+    EXPECT_GT(refined[i].score, 0.9) << "patch " << i;
+    EXPECT_NEAR(n.norm(), 1.0, 1e-5);
+    ASSERT_EQ(refined[i].view_scores.size(), 3u);
+    double mean = 0.0;
+    for (float s : refined[i].view_scores) mean += s;
+    EXPECT_NEAR(mean / 3.0, refined[i].score, 1e-5);
+    worst_depth = std::max(worst_depth, depth_error);
+    worst_angle = std::max(worst_angle, angle_error);
+    lowest_score = std::min(lowest_score, static_cast<double>(refined[i].score));
+  }
+  const std::vector<RefinedPatchReference> expected =
+      PatchRefineReference(scene.group, patches, views, options);
+  const RefComparison c = CompareWithReference(refined, expected);
+  std::printf(
+      "[ REFINE   ] %zu patches: worst depth error %.3f footprints, worst normal error %.2f deg, "
+      "lowest score %.4f; vs reference: worst score error %.3g, %d same-path (worst depth %.3g "
+      "fp, angle %.3g rad)\n",
+      refined.size(), worst_depth, worst_angle, lowest_score, c.worst_score_error, c.same_path,
+      c.worst_depth_error, c.worst_angle_error);
+}
+
+TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 61);
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 16, 4.0, 25.0, 62, &patches, &views);
+  PatchRefinerOptions options;
+  options.patch_size = 5;
+  options.iterations = 12;
+  PatchRefiner refiner(context(), options);
+  refiner.SetGroup(scene.group);
+  const std::vector<RefinedPatch> refined = refiner.Refine(patches, views);
+  const RefComparison c =
+      CompareWithReference(refined, PatchRefineReference(scene.group, patches, views, options));
+  std::printf("[ REFINE   ] harder: worst score error %.3g, %d/%zu same-path\n",
+              c.worst_score_error, c.same_path, patches.size());
+  // Few iterations: the steps stay large, so the decision margins do too and
+  // most searches must take the reference's exact path.
+  options.iterations = 4;
+  PatchRefiner short_refiner(context(), options);
+  short_refiner.SetGroup(scene.group);
+  const RefComparison s =
+      CompareWithReference(short_refiner.Refine(patches, views),
+                           PatchRefineReference(scene.group, patches, views, options));
+  std::printf(
+      "[ REFINE   ] 4 iterations: worst score error %.3g, %d/%zu same-path (worst depth %.3g "
+      "fp, angle %.3g rad)\n",
+      s.worst_score_error, s.same_path, patches.size(), s.worst_depth_error, s.worst_angle_error);
+  EXPECT_GE(s.same_path, static_cast<int>(patches.size()) / 2);
+  // Zero iterations return the start, scored.
+  options.iterations = 0;
+  PatchRefiner still(context(), options);
+  still.SetGroup(scene.group);
+  const std::vector<RefinedPatch> start = still.Refine(patches, views);
+  for (size_t i = 0; i < start.size(); ++i) {
+    EXPECT_EQ(start[i].moves, 0);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(start[i].patch.center.s[k], patches[i].center.s[k], 1e-4);
+      EXPECT_NEAR(start[i].patch.normal.s[k], patches[i].normal.s[k], 1e-5);
+    }
+  }
+}
+
+TEST_F(PatchRefinerTest, RejectsInvalidInputsBeforeEnqueue) {
+  const PlaneScene scene = MakePlaneScene(4, 97, 81, 71);
+  PatchRefiner refiner(context());
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 2, 1.0, 5.0, 72, &patches, &views);
+  EXPECT_THROW(refiner.Refine(patches, views), Error);  // Before SetGroup.
+  refiner.SetGroup(scene.group);
+  EXPECT_NO_THROW(refiner.Refine(patches, views));
+  auto expect_bad = [&](auto mutate, const std::string& text) {
+    std::vector<NccPatch> p = patches;
+    std::vector<std::vector<int>> v = views;
+    mutate(p, v);
+    try {
+      refiner.Refine(p, v);
+      ADD_FAILURE() << "no error for: " << text;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  using P = std::vector<NccPatch>;
+  using V = std::vector<std::vector<int>>;
+  expect_bad([](P&, V& v) { v.pop_back(); }, "view lists");
+  expect_bad([](P&, V& v) { v[1].clear(); }, "has 0 views");
+  expect_bad([](P&, V& v) { v[1].assign(kMaxViews + 1, 1); }, "views, expected 1 to");
+  expect_bad([](P&, V& v) { v[0][1] = 4; }, "is not in the group");
+  expect_bad([](P&, V& v) { v[0][1] = -1; }, "is not in the group");
+  expect_bad([](P&, V& v) { v[0][0] = 0; }, "is its reference image");
+  expect_bad([](P&, V& v) { v[1] = {1, 2, 1}; }, "is listed twice");
+  expect_bad([](P& p, V&) { p[0].reference = 7; }, "reference image 7");
+  expect_bad([](P& p, V&) { p[1].normal.s[2] = -p[1].normal.s[2]; }, "does not face");
+  expect_bad([](P& p, V&) { p[1].normal.s[2] *= 1.5f; }, "normal has length");
+  expect_bad([](P& p, V&) { p[0].center.s[0] = std::nanf(""); }, "non-finite");
+  EXPECT_THROW(PatchRefiner(context(),
+                            [] {
+                              PatchRefinerOptions o;
+                              o.iterations = -1;
+                              return o;
+                            }()),
+               Error);
+}
+
+}  // namespace
+}  // namespace sapmvs

@@ -1,0 +1,63 @@
+#include "plane_scene.h"
+
+#include <Eigen/Geometry>
+#include <random>
+
+namespace sapmvs::test {
+
+PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  PlaneScene scene;
+  constexpr double kPi = 3.14159265358979323846;
+  for (int k = 0; k < 16; ++k) {
+    const double wavelength = 0.8 + 2.2 * (0.5 + 0.5 * unit(rng));
+    const double angle = kPi * unit(rng);
+    const double kmag = 2.0 * kPi / wavelength;
+    scene.waves.emplace_back(kmag * std::cos(angle), kmag * std::sin(angle), kPi * unit(rng),
+                             8.0 + 4.0 * unit(rng));
+  }
+  // Georeferenced-looking world coordinates, translated to a local origin as
+  // the block does; the texture and patches live in the local frame.
+  const Eigen::Vector3d origin(500000.0, 6000000.0, 100.0);
+  const Intrinsics intrinsics = Intrinsics::FromPixels(150.0, 152.0, 0.5 * (width - 1) + 2.0,
+                                                       0.5 * (height - 1) - 1.5, width, height);
+  for (int i = 0; i < num_images; ++i) {
+    const Eigen::Vector3d center(6.0 * unit(rng), 6.0 * unit(rng), 40.0 + 3.0 * unit(rng));
+    // Nadir (camera x = world x, y = -world y, z down), then a yaw and a tilt
+    // of up to about 12 degrees.
+    Eigen::Matrix3d r_cw;
+    r_cw.col(0) = Eigen::Vector3d(1, 0, 0);
+    r_cw.col(1) = Eigen::Vector3d(0, -1, 0);
+    r_cw.col(2) = Eigen::Vector3d(0, 0, -1);
+    const Eigen::Matrix3d tilt = (Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitX()) *
+                                  Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(kPi * unit(rng), Eigen::Vector3d::UnitZ()))
+                                     .toRotationMatrix();
+    const Camera world(intrinsics, (tilt * r_cw).transpose(), center + origin);
+    scene.cameras.push_back(world.Translated(origin));
+  }
+  for (const Camera& camera : scene.cameras) {
+    std::vector<float> image(static_cast<size_t>(width) * height);
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const Eigen::Vector3d d = camera.Ray(Eigen::Vector2d(u, v));
+        const Eigen::Vector3d x = camera.center() - (camera.center().z() / d.z()) * d;
+        image[static_cast<size_t>(v) * width + u] = static_cast<float>(scene.Texture(x.x(), x.y()));
+      }
+    }
+    scene.pixels.push_back(std::move(image));
+  }
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    scene.group.images.push_back({scene.pixels[i].data(), {width, height, width}});
+    scene.group.cameras.push_back(MakeNccCamera(scene.cameras[i]));
+  }
+  return scene;
+}
+
+Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv) {
+  const Eigen::Vector3d d = camera.Ray(uv);
+  return camera.center() - (camera.center().z() / d.z()) * d;
+}
+
+}  // namespace sapmvs::test

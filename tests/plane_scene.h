@@ -1,0 +1,38 @@
+#pragma once
+// A synthetic scene for kernel tests: a textured ground plane z = 0 (local frame)
+// seen by pinhole cameras looking down from about 40 m with random tilts; the images
+// are rendered by casting each pixel's ray onto the plane, so the true plane is
+// photo-consistent.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "ncc_scorer.h"
+#include "sapmvs/camera.h"
+
+namespace sapmvs::test {
+
+struct PlaneScene {
+  std::vector<std::vector<float>> pixels;
+  std::vector<Camera> cameras;  // Local frame.
+  NccGroup group;
+  // Texture: a sum of 16 plane waves (wavelengths 0.8 to 3 m, i.e. about 3 to
+  // 11 pixels), non-periodic enough that a shifted patch does not match.
+  std::vector<Eigen::Vector4d> waves;  // (kx, ky, phase, amplitude).
+
+  double Texture(double x, double y) const {
+    double value = 128.0;
+    for (const Eigen::Vector4d& w : waves) value += w[3] * std::sin(w[0] * x + w[1] * y + w[2]);
+    return value;
+  }
+};
+
+// `num_images` cameras of `width` x `height` px over the plane, deterministic
+// for `seed`.
+PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed);
+
+// Ground point (z = 0) seen at pixel `uv` of `camera`.
+Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv);
+
+}  // namespace sapmvs::test
