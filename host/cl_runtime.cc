@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <iostream>
@@ -418,6 +419,12 @@ BuildOptions& BuildOptions::Define(const std::string& name, const std::string& v
   }
   defines_[name] = value;
   return *this;
+}
+
+BuildOptions& BuildOptions::Define(const std::string& name, float value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.9gf", static_cast<double>(value));
+  return Define(name, std::string(text));
 }
 
 std::string BuildOptions::Render() const {

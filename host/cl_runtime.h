@@ -330,6 +330,9 @@ class BuildOptions {
   BuildOptions& Define(const std::string& name, T value) {
     return Define(name, std::to_string(value));
   }
+  // A float literal that parses back to exactly `value` in OpenCL C
+  // ("%.9gf": 9 significant digits round-trip every float).
+  BuildOptions& Define(const std::string& name, float value);
 
   const std::map<std::string, std::string>& defines() const { return defines_; }
   // The complete option string: "-cl-std=CL1.2 -D A=1 -D B=2".

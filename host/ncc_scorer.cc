@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -36,14 +35,6 @@ std::string OptionsProblem(const NccScorerOptions& o) {
     return "work_group_size >= 1 (work_group_size = " + std::to_string(o.work_group_size) + ")";
   }
   return "";
-}
-
-// A float that parses back to exactly `value` in OpenCL C ("1e-04f" style is
-// not exact for every value; 9 significant digits are).
-std::string FloatLiteral(float value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.9gf", static_cast<double>(value));
-  return text;
 }
 
 cl_float4 Float4(double x, double y, double z, double w) {
@@ -169,7 +160,7 @@ NccScorer::NccScorer(ClContext& context, const NccScorerOptions& options)
   const std::string problem = OptionsProblem(options);
   if (!problem.empty()) throw Error("NccScorerOptions: expected " + problem);
   BuildOptions defines;
-  defines.Define("NCC_MIN_VARIANCE", FloatLiteral(kNccMinVariance))
+  defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
       .Define("PATCH_SIZE", options.patch_size)
       .Define("WORK_GROUP_SIZE", options.work_group_size);
   const ClProgram& program = context_.Program(kKernelFile, defines);

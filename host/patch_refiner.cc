@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -42,13 +41,6 @@ std::string OptionsProblem(const PatchRefinerOptions& o) {
     return "max_angle_deg in (0, 89] (max_angle_deg = " + std::to_string(o.max_angle_deg) + ")";
   }
   return "";
-}
-
-// A float that parses back to exactly `value` in OpenCL C.
-std::string FloatLiteral(float value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.9gf", static_cast<double>(value));
-  return text;
 }
 
 Eigen::Vector3d Xyz(const cl_float4& v) { return {v.s[0], v.s[1], v.s[2]}; }
@@ -137,7 +129,7 @@ PatchRefiner::PatchRefiner(ClContext& context, const PatchRefinerOptions& option
   if (!problem.empty()) throw Error("PatchRefinerOptions: expected " + problem);
   BuildOptions defines;
   defines.Define("MAX_VIEWS", kMaxViews)
-      .Define("NCC_MIN_VARIANCE", FloatLiteral(kNccMinVariance))
+      .Define("NCC_MIN_VARIANCE", kNccMinVariance)
       .Define("PATCH_SIZE", options.patch_size)
       .Define("WORK_GROUP_SIZE", options.work_group_size);
   kernel_ = context_.Program(kKernelFile, defines).Kernel(kKernel);

@@ -136,13 +136,4 @@ BENCHMARK(BM_BilinearReference)
 }  // namespace
 }  // namespace sapmvs
 
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  const sapmvs::SharedContext& shared = sapmvs::Shared();
-  benchmark::AddCustomContext("opencl_device", shared.context ? shared.context->device().Describe()
-                                                              : "none (" + shared.error + ")");
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return sapmvs::bench::RunMain(argc, argv); }

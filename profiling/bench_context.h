@@ -3,6 +3,8 @@
 // profiling on, on the default device (or SAPMVS_DEVICE). A benchmark that
 // finds `error` set skips with it.
 
+#include <benchmark/benchmark.h>
+
 #include <exception>
 #include <memory>
 #include <string>
@@ -29,6 +31,18 @@ inline SharedContext& Shared() {
     return s;
   }();
   return *shared;
+}
+
+// The benchmarks' main(): records the device in the report's context.
+inline int RunMain(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  const SharedContext& shared = Shared();
+  benchmark::AddCustomContext("opencl_device", shared.context ? shared.context->device().Describe()
+                                                              : "none (" + shared.error + ")");
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
 }
 
 }  // namespace sapmvs::bench

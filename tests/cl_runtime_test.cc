@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -217,6 +219,14 @@ TEST(ClBuildOptionsTest, RenderedSortedWithStandard) {
   EXPECT_THROW(BuildOptions().Define("1X", 1), std::invalid_argument);
   EXPECT_THROW(BuildOptions().Define("X", "a b"), std::invalid_argument);
   EXPECT_THROW(BuildOptions().Define("X", ""), std::invalid_argument);
+}
+
+TEST(ClBuildOptionsTest, FloatDefinesParseBackExactly) {
+  for (float value : {1e-4f, 0.1f, 3.0f, 1.17549435e-38f, -2.5e7f}) {
+    const std::string text = BuildOptions().Define("V", value).defines().at("V");
+    ASSERT_EQ(text.back(), 'f') << text;  // a float literal, not a double
+    EXPECT_EQ(std::strtof(text.substr(0, text.size() - 1).c_str(), nullptr), value) << text;
+  }
 }
 
 // --- Context, programs, launches -------------------------------------------------
