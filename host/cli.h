@@ -19,5 +19,6 @@ void RegisterDevicesCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterInfoCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global);
+void RegisterRunCommand(CLI::App& app, const GlobalFlags& global);
 
 }  // namespace sapmvs::cli

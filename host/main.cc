@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   sapmvs::cli::RegisterDevicesCommand(app, global);
   sapmvs::cli::RegisterInfoCommand(app, global);
   sapmvs::cli::RegisterSimulateCommand(app, global);
+  sapmvs::cli::RegisterRunCommand(app, global);
   sapmvs::cli::RegisterEvaluateCommand(app, global);
 
   try {

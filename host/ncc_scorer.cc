@@ -205,13 +205,18 @@ NccDeviceGroup UploadNccGroup(ClContext& context, const NccGroup& group) {
 
 void NccScorer::SetGroup(const NccGroup& group) {
   // Assigned only once everything is uploaded, so a failure keeps the old group.
-  group_ = UploadNccGroup(context_, group);
+  group_ = std::make_shared<const NccDeviceGroup>(UploadNccGroup(context_, group));
+}
+
+void NccScorer::UseGroup(std::shared_ptr<const NccDeviceGroup> group) {
+  if (!group || group->num_images == 0) throw Error("NccScorer::UseGroup: no images");
+  group_ = std::move(group);
 }
 
 std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
                                     const std::vector<NccPair>& pairs, ClEvent* event) {
-  if (group_.num_images == 0) throw Error("NccScorer::Score called before SetGroup");
-  ValidateNccBatch(patches, pairs, group_.num_images);
+  if (num_images() == 0) throw Error("NccScorer::Score called before SetGroup");
+  ValidateNccBatch(patches, pairs, group_->num_images);
   if (pairs.empty()) return {};
 
   ClBuffer patch_buffer(context_, patches.size() * sizeof(NccPatch), CL_MEM_READ_ONLY);
@@ -221,8 +226,8 @@ std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
   ClBuffer score_buffer(context_, pairs.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
   const cl_int num_pairs = static_cast<cl_int>(pairs.size());
-  score_kernel_.SetArgs(group_.images, group_.image_table, group_.cameras,
-                        cl_int{group_.num_images}, patch_buffer,
+  score_kernel_.SetArgs(group_->images, group_->image_table, group_->cameras,
+                        cl_int{group_->num_images}, patch_buffer,
                         static_cast<cl_int>(patches.size()), pair_buffer, num_pairs, score_buffer);
   ClEvent launched = context_.Enqueue(score_kernel_, NDRange(pairs.size()),
                                       NDRange(static_cast<size_t>(options_.work_group_size)));
@@ -234,9 +239,9 @@ std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
 }
 
 std::vector<float> NccScorer::ProbeSamples(int image, const std::vector<Eigen::Vector2f>& points) {
-  if (image < 0 || image >= group_.num_images) {
+  if (image < 0 || image >= num_images()) {
     throw Error("NCC probe image " + std::to_string(image) + " is not in the group of " +
-                std::to_string(group_.num_images) + " images");
+                std::to_string(num_images()) + " images");
   }
   if (points.size() > static_cast<size_t>(INT_MAX)) throw Error("NCC probe batch too large");
   if (points.empty()) return {};
@@ -244,7 +249,7 @@ std::vector<float> NccScorer::ProbeSamples(int image, const std::vector<Eigen::V
   ClBuffer point_buffer(context_, points.size() * sizeof(Eigen::Vector2f), CL_MEM_READ_ONLY);
   point_buffer.Write(points.data(), points.size() * sizeof(Eigen::Vector2f));
   ClBuffer value_buffer(context_, points.size() * sizeof(float), CL_MEM_WRITE_ONLY);
-  probe_kernel_.SetArgs(group_.images, group_.image_table, cl_int{image}, point_buffer,
+  probe_kernel_.SetArgs(group_->images, group_->image_table, cl_int{image}, point_buffer,
                         static_cast<cl_int>(points.size()), value_buffer);
   context_.Enqueue(probe_kernel_, NDRange(points.size()),
                    NDRange(static_cast<size_t>(options_.work_group_size)));

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "bilinear_sampler.h"
@@ -120,7 +121,10 @@ class NccScorer {
   // Validates and uploads the group; its images then stay on the device until
   // the next SetGroup. Blocking.
   void SetGroup(const NccGroup& group);
-  int num_images() const { return group_.num_images; }
+  // Uses a group already on the device, shared with other scorers and
+  // refiners of the same context (one upload, however many patch sizes).
+  void UseGroup(std::shared_ptr<const NccDeviceGroup> group);
+  int num_images() const { return group_ ? group_->num_images : 0; }
 
   // scores[i] = NCC of pairs[i] (see NccPair), or NaN. Validates every index
   // and every patch (finite, unit normal within 1e-3) before enqueueing and
@@ -140,7 +144,7 @@ class NccScorer {
   NccScorerOptions options_;
   ClKernel score_kernel_;
   ClKernel probe_kernel_;
-  NccDeviceGroup group_;
+  std::shared_ptr<const NccDeviceGroup> group_;
 };
 
 // Throws Error naming the first pair or patch the kernel must not see.

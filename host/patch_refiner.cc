@@ -136,14 +136,23 @@ PatchRefiner::PatchRefiner(ClContext& context, const PatchRefinerOptions& option
 }
 
 void PatchRefiner::SetGroup(const NccGroup& group) {
-  group_ = UploadNccGroup(context_, group);
+  group_ = std::make_shared<const NccDeviceGroup>(UploadNccGroup(context_, group));
   host_cameras_ = group.cameras;
+}
+
+void PatchRefiner::UseGroup(std::shared_ptr<const NccDeviceGroup> group,
+                            std::vector<NccCamera> cameras) {
+  if (!group || group->num_images == 0 || static_cast<int>(cameras.size()) != group->num_images) {
+    throw Error("PatchRefiner::UseGroup: no images, or cameras do not match the group");
+  }
+  group_ = std::move(group);
+  host_cameras_ = std::move(cameras);
 }
 
 std::vector<RefinedPatch> PatchRefiner::Refine(const std::vector<NccPatch>& patches,
                                                const std::vector<std::vector<int>>& views,
                                                ClEvent* event) {
-  if (group_.num_images == 0) throw Error("PatchRefiner::Refine called before SetGroup");
+  if (num_images() == 0) throw Error("PatchRefiner::Refine called before SetGroup");
   ValidatePatchRefineBatch(patches, views, host_cameras_);
   if (patches.empty()) return {};
 
@@ -162,7 +171,7 @@ std::vector<RefinedPatch> PatchRefiner::Refine(const std::vector<NccPatch>& patc
   ClBuffer result_buffer(context_, patches.size() * sizeof(RefinedPatchOut), CL_MEM_WRITE_ONLY);
   ClBuffer score_buffer(context_, indices.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
-  kernel_.SetArgs(group_.images, group_.image_table, group_.cameras, cl_int{group_.num_images},
+  kernel_.SetArgs(group_->images, group_->image_table, group_->cameras, cl_int{group_->num_images},
                   patch_buffer, static_cast<cl_int>(patches.size()), offset_buffer, index_buffer,
                   cl_int{options_.iterations}, static_cast<cl_float>(options_.depth_step),
                   static_cast<cl_float>(Radians(options_.angle_step_deg)),

@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "cl_runtime.h"
@@ -94,7 +95,10 @@ class PatchRefiner {
 
   // Validates and uploads the group (as NccScorer::SetGroup). Blocking.
   void SetGroup(const NccGroup& group);
-  int num_images() const { return group_.num_images; }
+  // Uses a group already uploaded (see NccScorer::UseGroup); `cameras` are
+  // its host cameras, for validation.
+  void UseGroup(std::shared_ptr<const NccDeviceGroup> group, std::vector<NccCamera> cameras);
+  int num_images() const { return group_ ? group_->num_images : 0; }
 
   // Refines patches[i] against views[i]. Validates everything first (see
   // ValidatePatchRefineBatch) and throws Error naming the first bad patch or
@@ -109,7 +113,7 @@ class PatchRefiner {
   ClContext& context_;
   PatchRefinerOptions options_;
   ClKernel kernel_;
-  NccDeviceGroup group_;
+  std::shared_ptr<const NccDeviceGroup> group_;
   std::vector<NccCamera> host_cameras_;
 };
 

@@ -90,7 +90,8 @@ TEST(Cli, HelpListsOnlyWorkingSubcommands) {
   EXPECT_NE(r.out.find("info"), std::string::npos);
   EXPECT_NE(r.out.find("simulate"), std::string::npos);
   EXPECT_NE(r.out.find("evaluate"), std::string::npos);
-  for (const char* later : {"run", "plan"}) {
+  EXPECT_NE(r.out.find("run"), std::string::npos);
+  for (const char* later : {"plan"}) {
     EXPECT_EQ(r.out.find(std::string("  ") + later + " "), std::string::npos) << later;
   }
 }

@@ -1,0 +1,79 @@
+// `sapmvs run BLOCK --out DIR`: dense matching of a block small enough for one
+// group. Flags map one to one onto RunOptions / MatcherOptions.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <memory>
+
+#include "cli.h"
+#include "sapmvs/dense_run.h"
+
+namespace sapmvs::cli {
+
+void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
+  auto o = std::make_shared<RunOptions>();
+  auto mode = std::make_shared<std::string>("sapmvs");
+  auto no_edges = std::make_shared<bool>(false);
+  MatcherOptions& m = o->matcher;
+  CLI::App* cmd = app.add_subcommand("run", "Dense matching of a block: cloud.ply and report.json");
+  cmd->add_option("block", o->block,
+                  "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
+      ->required();
+  cmd->add_option("--out", o->out, "Output folder")->required();
+  cmd->add_option("--mode", *mode, "sapmvs (self-adaptive patch) or pmvs")->capture_default_str();
+  cmd->add_option("--device", o->device,
+                  "OpenCL device: index or name substring (see `sapmvs devices`)");
+  cmd->add_option("--level", m.level, "Pyramid level: 0 full resolution, 1 half, ...")
+      ->capture_default_str();
+  cmd->add_option("--csize", m.cell_size, "Cell size, pixels at the level")->capture_default_str();
+  cmd->add_option("--threshold", m.threshold, "NCC a view needs after optimisation")
+      ->capture_default_str();
+  cmd->add_option("--threshold-before", m.threshold_before, "NCC a view needs before optimisation")
+      ->capture_default_str();
+  cmd->add_option("--min-image-num", m.min_image_num, "Images a patch must be photo-consistent in")
+      ->capture_default_str();
+  cmd->add_option("--max-angle", m.max_angle_deg, "Smallest triangulation angle of a view, degrees")
+      ->capture_default_str();
+  cmd->add_option("--view-angle", m.view_angle_deg,
+                  "Largest angle of a view to a patch normal, degrees")
+      ->capture_default_str();
+  cmd->add_option("--wsize", m.window_size, "Matching window, pixels (odd)")->capture_default_str();
+  cmd->add_option("--adaptive-sizes", m.adaptive_sizes, "sapmvs patch sides, largest first")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--features-per-block", m.features_per_block,
+                  "Features per detector per 32x32 block")
+      ->capture_default_str();
+  cmd->add_option("--epipolar-distance", m.epipolar_distance,
+                  "Seed candidates: pixels from the epipolar line")
+      ->capture_default_str();
+  cmd->add_option("--candidates", m.candidates_per_feature, "Seed candidates tried per feature")
+      ->capture_default_str();
+  cmd->add_flag("--no-edges", *no_edges, "sapmvs: do not match edges (no propagation barriers)");
+  cmd->add_option("--max-wave", m.max_wave, "Most candidates per device launch")
+      ->capture_default_str();
+  cmd->add_option("--max-waves", m.max_waves, "Stop after this many waves (0 = none)")
+      ->capture_default_str();
+  cmd->add_option("--depth-tolerance", m.depth_tolerance,
+                  "Filter: depth agreement, pixel footprints")
+      ->capture_default_str();
+  cmd->add_option("--neighbour-radius", m.neighbour_radius,
+                  "Filter: neighbourhood radius, footprints")
+      ->capture_default_str();
+  cmd->add_option("--min-neighbours", m.min_neighbours, "Filter: neighbours a point needs")
+      ->capture_default_str();
+  cmd->add_option("--plane-tolerance", m.plane_tolerance,
+                  "Filter: distance to the local plane, footprints")
+      ->capture_default_str();
+  cmd->add_option("--min-cluster", m.min_cluster_size, "Filter: smallest cluster kept, points")
+      ->capture_default_str();
+  cmd->callback([o, mode, no_edges, &global] {
+    o->matcher.mode = ParseMatchMode(*mode);
+    o->matcher.use_edges = !*no_edges;
+    o->matcher.progress = !global.quiet;
+    const RunReport report = RunDense(*o);
+    PrintRunSummary(report, std::cout);
+  });
+}
+
+}  // namespace sapmvs::cli

@@ -1,0 +1,139 @@
+#include "edge_matcher.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "feature_detector.h"
+#include "seed_matcher.h"
+
+namespace sapmvs {
+namespace {
+
+// Candidates searched per edge pixel at most; a longer segment (a huge depth
+// range) keeps those nearest the middle of the range.
+constexpr int kMaxEdgeCandidates = 48;
+
+struct EdgeQuery {
+  int image, x, y;
+  int first_patch, num_candidates;
+};
+
+}  // namespace
+
+std::vector<EdgeMap> MatchEdges(const MatchGroupData& group, const MatcherOptions& options,
+                                const std::vector<std::pair<double, double>>& depth_range,
+                                PatchEngine& engine, EdgeMatchStats* stats) {
+  const int n = static_cast<int>(group.images.size());
+  std::vector<cv::Mat> edges(n);
+  for (int i = 0; i < n; ++i) {
+    edges[i] = DetectEdges(group.images[i].grey, options.canny_low, options.canny_high);
+  }
+  std::vector<EdgeMap> maps(n);
+  std::vector<EdgeQuery> queries;
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<float> along;  // position along the segment, pixels of the view
+  const int margin = options.window_size / 2 + 1;
+  for (int i = 0; i < n; ++i) {
+    const MatchImage& ref = group.images[i];
+    maps[i].matched = cv::Mat::zeros(ref.grey.size(), CV_8U);
+    maps[i].points = cv::Mat::zeros(ref.grey.size(), CV_32FC3);
+    const auto [dmin, dmax] = depth_range[i];
+    if (ref.views.empty() || !(dmin < dmax)) continue;
+    const int j = ref.views[0];
+    const Camera& cam = group.images[j].camera;
+    for (int y = margin; y < ref.grey.rows - margin; ++y) {
+      for (int x = margin; x < ref.grey.cols - margin; ++x) {
+        if (!edges[i].at<uint8_t>(y, x)) continue;
+        if (stats) ++stats->edge_pixels;
+        const Eigen::Vector2d uv(x, y);
+        const Eigen::Vector3d p0 = ref.camera.BackProject(uv, dmin);
+        const Eigen::Vector3d p1 = ref.camera.BackProject(uv, dmax);
+        if (!(cam.Depth(p0) > 0) || !(cam.Depth(p1) > 0)) continue;
+        const Eigen::Vector2d a = cam.Project(p0), b = cam.Project(p1);
+        const double len = (b - a).norm();
+        if (!(len > 0)) continue;
+        const int steps = static_cast<int>(std::ceil(len * 2));
+        std::vector<std::pair<double, Eigen::Vector2i>> hits;
+        Eigen::Vector2i last(-1, -1);
+        for (int s = 0; s <= steps; ++s) {
+          const Eigen::Vector2d q = a + (b - a) * (static_cast<double>(s) / steps);
+          const Eigen::Vector2i qi(static_cast<int>(std::lround(q.x())),
+                                   static_cast<int>(std::lround(q.y())));
+          if (qi == last) continue;
+          last = qi;
+          if (qi.x() < margin || qi.y() < margin || qi.x() >= cam.width() - margin ||
+              qi.y() >= cam.height() - margin) {
+            continue;
+          }
+          if (edges[j].at<uint8_t>(qi.y(), qi.x())) hits.emplace_back(s * len / steps, qi);
+        }
+        if (hits.empty()) continue;
+        if (static_cast<int>(hits.size()) > kMaxEdgeCandidates) {
+          std::sort(hits.begin(), hits.end(), [&](const auto& p, const auto& q) {
+            return std::abs(p.first - 0.5 * len) < std::abs(q.first - 0.5 * len);
+          });
+          hits.resize(kMaxEdgeCandidates);
+        }
+        EdgeQuery query{i, x, y, static_cast<int>(patches.size()), 0};
+        for (const auto& [t, qi] : hits) {
+          const Eigen::Vector3d X = TriangulateMidpoint(ref.camera, uv, cam, qi.cast<double>());
+          if (!X.allFinite()) continue;
+          const Eigen::Vector3d normal = (ref.camera.center() - X).normalized();
+          const int k = static_cast<int>(patches.size());
+          patches.push_back(MakeNccPatch(X, normal, i));
+          points.push_back(X);
+          along.push_back(static_cast<float>(t));
+          pairs.push_back(NccPair{k, j});
+          ++query.num_candidates;
+        }
+        if (query.num_candidates > 0) queries.push_back(query);
+      }
+    }
+  }
+  const std::vector<float> scores = engine.Score(patches, pairs);
+  // Second-view confirmation of each query's best candidate, one more launch.
+  std::vector<int> best(queries.size(), -1);
+  std::vector<NccPair> confirm;
+  std::vector<int> confirm_of;
+  for (size_t q = 0; q < queries.size(); ++q) {
+    const EdgeQuery& e = queries[q];
+    int b = -1;
+    for (int k = e.first_patch; k < e.first_patch + e.num_candidates; ++k) {
+      if (std::isfinite(scores[k]) && (b < 0 || scores[k] > scores[b])) b = k;
+    }
+    if (b < 0 || scores[b] < options.threshold) continue;
+    bool ambiguous = false;
+    for (int k = e.first_patch; k < e.first_patch + e.num_candidates; ++k) {
+      if (k != b && std::abs(along[k] - along[b]) > 2.0f && std::isfinite(scores[k]) &&
+          scores[k] > scores[b] - kEdgeAmbiguity) {
+        ambiguous = true;
+      }
+    }
+    if (ambiguous) continue;
+    best[q] = b;
+    const MatchImage& ref = group.images[e.image];
+    if (ref.views.size() > 1) {
+      confirm.push_back(NccPair{b, ref.views[1]});
+      confirm_of.push_back(static_cast<int>(q));
+    }
+  }
+  const std::vector<float> second = engine.Score(patches, confirm);
+  for (size_t c = 0; c < confirm.size(); ++c) {
+    if (!(std::isfinite(second[c]) && second[c] >= options.threshold_before))
+      best[confirm_of[c]] = -1;
+  }
+  for (size_t q = 0; q < queries.size(); ++q) {
+    if (best[q] < 0) continue;
+    const EdgeQuery& e = queries[q];
+    const Eigen::Vector3d& X = points[best[q]];
+    maps[e.image].matched.at<uint8_t>(e.y, e.x) = 255;
+    maps[e.image].points.at<cv::Vec3f>(e.y, e.x) =
+        cv::Vec3f(static_cast<float>(X.x()), static_cast<float>(X.y()), static_cast<float>(X.z()));
+    if (stats) ++stats->matched;
+  }
+  return maps;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,219 @@
+#include "sapmvs/matcher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "cl_runtime.h"
+#include "edge_matcher.h"
+#include "feature_detector.h"
+#include "match_group.h"
+#include "patch_engine.h"
+#include "patch_filter.h"
+#include "propagation.h"
+#include "sapmvs/error.h"
+#include "sapmvs/kernel_limits.h"
+#include "sapmvs/progress.h"
+#include "seed_matcher.h"
+
+namespace sapmvs {
+namespace {
+
+std::string FirstProblem(const MatcherOptions& o) {
+  std::ostringstream s;
+  if (o.level < 0 || o.level > 6)
+    s << "level in 0..6 (level = " << o.level << ")";
+  else if (o.cell_size < 1 || o.cell_size > 16)
+    s << "cell_size in 1..16 (cell_size = " << o.cell_size << ")";
+  else if (!(o.threshold > -1 && o.threshold <= 1))
+    s << "threshold in (-1, 1] (threshold = " << o.threshold << ")";
+  else if (!(o.threshold_before > -1 && o.threshold_before <= o.threshold))
+    s << "threshold_before in (-1, threshold] (threshold_before = " << o.threshold_before << ")";
+  else if (o.min_image_num < 2 || o.min_image_num > kMaxViews)
+    s << "min_image_num in 2.." << kMaxViews << " (min_image_num = " << o.min_image_num << ")";
+  else if (!(o.max_angle_deg >= 0 && o.max_angle_deg < 90))
+    s << "max_angle_deg in [0, 90) (max_angle_deg = " << o.max_angle_deg << ")";
+  else if (!(o.view_angle_deg > 0 && o.view_angle_deg < 90))
+    s << "view_angle_deg in (0, 90) (view_angle_deg = " << o.view_angle_deg << ")";
+  else if (o.window_size < 3 || o.window_size > kMaxPatchSize || o.window_size % 2 == 0)
+    s << "window_size odd in 3.." << kMaxPatchSize << " (window_size = " << o.window_size << ")";
+  else if (o.features_per_block < 1)
+    s << "features_per_block >= 1";
+  else if (!(o.epipolar_distance > 0))
+    s << "epipolar_distance > 0";
+  else if (o.candidates_per_feature < 1)
+    s << "candidates_per_feature >= 1";
+  else if (o.max_wave < 1)
+    s << "max_wave >= 1";
+  else if (o.max_waves < 0)
+    s << "max_waves >= 0";
+  else if (!(o.depth_tolerance > 0))
+    s << "depth_tolerance > 0";
+  else if (!(o.neighbour_radius > 0))
+    s << "neighbour_radius > 0";
+  else if (o.min_neighbours < 0)
+    s << "min_neighbours >= 0";
+  else if (!(o.plane_tolerance > 0))
+    s << "plane_tolerance > 0";
+  else if (o.min_cluster_size < 0)
+    s << "min_cluster_size >= 0";
+  if (!s.str().empty()) return s.str();
+  // PMVS uses window_size alone and ignores adaptive_sizes.
+  if (o.mode == MatchMode::kSapmvs) {
+    if (o.adaptive_sizes.empty() || o.adaptive_sizes.back() != o.window_size) {
+      return "adaptive_sizes ending with window_size (" + std::to_string(o.window_size) + ")";
+    }
+    for (size_t i = 0; i < o.adaptive_sizes.size(); ++i) {
+      const int v = o.adaptive_sizes[i];
+      if (v < 3 || v > kMaxPatchSize || v % 2 == 0 || (i > 0 && v >= o.adaptive_sizes[i - 1])) {
+        return "adaptive_sizes odd, decreasing, in 3.." + std::to_string(kMaxPatchSize);
+      }
+    }
+  }
+  return "";
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double DeviceSeconds(const PatchEngine& engine) {
+  double s = 0;
+  for (const auto& [name, t] : engine.kernel_times()) s += t.seconds;
+  return s;
+}
+
+}  // namespace
+
+std::string ToString(MatchMode mode) { return mode == MatchMode::kSapmvs ? "sapmvs" : "pmvs"; }
+
+MatchMode ParseMatchMode(const std::string& text) {
+  if (text == "sapmvs") return MatchMode::kSapmvs;
+  if (text == "pmvs") return MatchMode::kPmvs;
+  throw Error("unknown matching mode '" + text + "': expected sapmvs or pmvs");
+}
+
+std::string MatcherOptions::Problem() const { return FirstProblem(*this); }
+
+bool MatcherOptions::Check() const {
+  const std::string problem = Problem();
+  if (!problem.empty()) std::cerr << "MatcherOptions: expected " << problem << "\n";
+  return problem.empty();
+}
+
+MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
+                       const MatcherOptions& options, ClContext& context) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("matcher options: expected " + problem);
+  std::vector<int> ids = image_ids;
+  if (ids.empty()) {
+    for (size_t i = 0; i < block.images.size(); ++i) ids.push_back(static_cast<int>(i));
+  }
+  MatchResult result;
+  MatchStats& stats = result.stats;
+  const bool show = options.progress && Progress::TerminalAllowsProgress();
+  auto stage_start = std::chrono::steady_clock::now();
+  double device_before = 0;
+  const PatchEngine* engine_ptr = nullptr;
+  auto end_stage = [&](const std::string& name) {
+    StageTime t;
+    t.wall = Seconds(stage_start);
+    const double device_now = engine_ptr ? DeviceSeconds(*engine_ptr) : 0;
+    t.device = device_now - device_before;
+    device_before = device_now;
+    stats.stages.emplace_back(name, t);
+    stage_start = std::chrono::steady_clock::now();
+  };
+
+  MatchGroupData group = LoadMatchGroup(block, ids, options.level);
+  SelectViews(options, &group);
+  stats.images = static_cast<int>(group.images.size());
+  stats.gsd = group.gsd;
+  end_stage("load");
+
+  const int largest = options.mode == MatchMode::kSapmvs
+                          ? std::max(options.window_size, options.adaptive_sizes.front())
+                          : options.window_size;
+  const int margin = largest / 2 + 1;
+  std::vector<std::vector<Feature>> features(group.images.size());
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    features[i] = DetectFeatures(group.images[i].grey, options.features_per_block, margin);
+    stats.features += static_cast<long>(features[i].size());
+  }
+  end_stage("features");
+
+  const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  PatchEngine engine(context, group, options);
+  engine_ptr = &engine;
+  Propagator propagator(group, options, engine);
+  propagator.RunSeeds(seeds);
+  stats.seeds_tried = propagator.seeds_tried();
+  stats.seeds_accepted = propagator.seeds_accepted();
+  end_stage("seeds");
+
+  if (options.mode == MatchMode::kSapmvs && options.use_edges) {
+    std::vector<std::pair<double, double>> ranges(group.images.size(), {0.0, 0.0});
+    for (size_t i = 0; i < group.images.size(); ++i) {
+      std::vector<double> d = propagator.seed_depths()[i];
+      if (d.size() < 10) continue;
+      std::sort(d.begin(), d.end());
+      const double lo = d[d.size() / 20], hi = d[d.size() - 1 - d.size() / 20];
+      const double pad = 0.25 * (hi - lo) + 2.0 * group.gsd;
+      ranges[i] = {lo - pad, hi + pad};
+    }
+    EdgeMatchStats es;
+    propagator.SetEdges(MatchEdges(group, options, ranges, engine, &es));
+    stats.edge_points = es.edge_pixels;
+    stats.matched_edge_points = es.matched;
+    end_stage("edges");
+  }
+
+  propagator.RunWaves([&](long wave, long size, long points) {
+    if (!show) return;
+    std::fprintf(stderr, "\r%s: wave %ld, %ld candidates, %ld points   ",
+                 ToString(options.mode).c_str(), wave, size, points);
+    std::fflush(stderr);
+  });
+  if (show) std::fprintf(stderr, "\n");
+  stats.candidates = propagator.candidates();
+  stats.waves = propagator.waves();
+  stats.largest_wave = propagator.largest_wave();
+  stats.patches = static_cast<long>(propagator.patches().size());
+  for (const AcceptedPatch& p : propagator.patches()) ++stats.accepted_by_size[p.size];
+  end_stage("propagation");
+
+  const auto& points = propagator.points();
+  const auto& patches = propagator.patches();
+  stats.points_before_filter = static_cast<long>(points.size());
+  const std::vector<bool> keep = FilterPoints(group, options, points, patches, &stats);
+  end_stage("filter");
+
+  PointCloud& cloud = result.cloud;
+  cloud.has_normals = cloud.has_colors = cloud.has_scores = cloud.has_views = true;
+  cloud.crs = block.crs;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!keep[i]) continue;
+    const DensePoint& d = points[i];
+    const AcceptedPatch& p = patches[d.patch];
+    const MatchImage& ref = group.images[p.ref];
+    CloudPoint c;
+    c.position = d.x + group.origin;
+    c.normal = p.normal.cast<float>();
+    const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, ref.color.cols - 1);
+    const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, ref.color.rows - 1);
+    const cv::Vec3b bgr = ref.color.at<cv::Vec3b>(y, x);
+    c.color = {bgr[2], bgr[1], bgr[0]};
+    c.score = p.score;
+    c.num_views = 1 + static_cast<int>(p.views.size());
+    cloud.points.push_back(c);
+  }
+  stats.points = static_cast<long>(cloud.points.size());
+  stats.kernels = engine.kernel_times();
+  end_stage("output");
+  return result;
+}
+
+}  // namespace sapmvs

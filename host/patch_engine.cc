@@ -1,0 +1,229 @@
+#include "patch_engine.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sapmvs/error.h"
+
+namespace sapmvs {
+namespace {
+
+// Polishing a refined 7 x 7 patch at a larger size: a few rounds of small
+// steps, since the start is already within a footprint and a few degrees.
+constexpr int kPolishIterations = 6;
+constexpr double kPolishDepthStep = 0.25;
+constexpr double kPolishAngleStepDeg = 2.0;
+
+// True when image `camera` sees the plane (c, n) at most view_angle off its normal.
+bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,
+           double cos_max) {
+  return n.dot((camera.center() - c).normalized()) >= cos_max;
+}
+
+}  // namespace
+
+PatchEngine::PatchEngine(ClContext& context, const MatchGroupData& group,
+                         const MatcherOptions& options)
+    : context_(context), group_(group), options_(options) {
+  device_group_ = std::make_shared<const NccDeviceGroup>(UploadNccGroup(context_, group_.ncc));
+  std::vector<int> sizes = {options_.window_size};
+  if (options_.mode == MatchMode::kSapmvs) {
+    sizes.insert(sizes.end(), options_.adaptive_sizes.begin(), options_.adaptive_sizes.end());
+  }
+  for (const int size : sizes) {
+    if (scorers_.count(size)) continue;
+    NccScorerOptions so;
+    so.patch_size = size;
+    auto scorer = std::make_unique<NccScorer>(context_, so);
+    scorer->UseGroup(device_group_);
+    scorers_[size] = std::move(scorer);
+  }
+  PatchRefinerOptions ro;
+  ro.patch_size = options_.window_size;
+  refiner_ = std::make_unique<PatchRefiner>(context_, ro);
+  refiner_->UseGroup(device_group_, group_.ncc.cameras);
+  if (options_.mode == MatchMode::kSapmvs) {
+    for (const int size : options_.adaptive_sizes) {
+      if (size <= options_.window_size) continue;
+      PatchRefinerOptions po;
+      po.patch_size = size;
+      po.iterations = kPolishIterations;
+      po.depth_step = kPolishDepthStep;
+      po.angle_step_deg = kPolishAngleStepDeg;
+      auto polisher = std::make_unique<PatchRefiner>(context_, po);
+      polisher->UseGroup(device_group_, group_.ncc.cameras);
+      polishers_[size] = std::move(polisher);
+    }
+  }
+}
+
+std::vector<RefinedPatch> PatchEngine::RefineWith(PatchRefiner& refiner,
+                                                  const std::vector<NccPatch>& patches,
+                                                  const std::vector<std::vector<int>>& views) {
+  if (patches.empty()) return {};
+  ClEvent event;
+  std::vector<RefinedPatch> out = refiner.Refine(patches, views, &event);
+  const int size = refiner.options().patch_size;
+  Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size),
+        static_cast<long>(patches.size()), event);
+  return out;
+}
+
+void PatchEngine::Count(const std::string& kernel, long items, const ClEvent& event) {
+  KernelTime& t = kernel_times_[kernel];
+  ++t.launches;
+  t.items += items;
+  if (event.profiling()) t.seconds += 1e-9 * static_cast<double>(event.DeviceTimeNs());
+}
+
+std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& patches,
+                                        const std::vector<NccPair>& pairs) {
+  if (pairs.empty()) return {};
+  ClEvent event;
+  std::vector<float> scores = scorers_.at(size)->Score(patches, pairs, &event);
+  Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size),
+        static_cast<long>(pairs.size()), event);
+  return scores;
+}
+
+std::vector<float> PatchEngine::Score(const std::vector<NccPatch>& patches,
+                                      const std::vector<NccPair>& pairs) {
+  return ScoreAt(options_.window_size, patches, pairs);
+}
+
+std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
+                                           const Eigen::Vector3d& normal, int ref, int half) const {
+  const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
+  std::vector<int> views;
+  for (const int v : group_.images[ref].views) {
+    const Camera& cam = group_.images[v].camera;
+    if (!(cam.Depth(center) > 0)) continue;
+    if (!cam.InImage(cam.Project(center), half + 1)) continue;
+    const Eigen::Vector3d to_cam = (cam.center() - center).normalized();
+    if (normal.dot(to_cam) < cos_max) continue;
+    views.push_back(v);
+  }
+  return views;
+}
+
+std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
+    const std::vector<PatchCandidate>& candidates) {
+  const int need = options_.min_image_num - 1;
+  const int half = options_.window_size / 2;
+  const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
+  std::vector<std::optional<AcceptedPatch>> results(candidates.size());
+
+  // 1. Visible views and the score before optimisation.
+  std::vector<NccPatch> patches;
+  std::vector<int> patch_of;  // candidate index of patches[k]
+  std::vector<std::vector<int>> visible;
+  std::vector<NccPair> pairs;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const PatchCandidate& c = candidates[i];
+    const Camera& ref = group_.images[c.ref].camera;
+    Eigen::Vector3d n = c.normal.normalized();
+    const Eigen::Vector3d to_ref = (ref.center() - c.center).normalized();
+    if (n.dot(to_ref) < 0) n = -n;
+    if (!n.allFinite() || n.dot(to_ref) < cos_max) continue;
+    if (!(ref.Depth(c.center) > 0) || !ref.InImage(ref.Project(c.center), half + 1)) continue;
+    std::vector<int> views = VisibleViews(c.center, n, c.ref, half);
+    if (static_cast<int>(views.size()) < need) continue;
+    const int k = static_cast<int>(patches.size());
+    patches.push_back(MakeNccPatch(c.center, n, c.ref));
+    patch_of.push_back(static_cast<int>(i));
+    for (const int v : views) pairs.push_back(NccPair{k, v});
+    visible.push_back(std::move(views));
+  }
+  const std::vector<float> before = ScoreAt(options_.window_size, patches, pairs);
+
+  // 2. Refine with the views that pass threshold_before.
+  std::vector<NccPatch> to_refine;
+  std::vector<std::vector<int>> refine_views;
+  std::vector<int> refine_of;
+  size_t pair_index = 0;
+  for (size_t k = 0; k < patches.size(); ++k) {
+    std::vector<int> kept;
+    for (const int v : visible[k]) {
+      const float s = before[pair_index++];
+      if (std::isfinite(s) && s >= options_.threshold_before) kept.push_back(v);
+    }
+    if (static_cast<int>(kept.size()) < need) continue;
+    to_refine.push_back(patches[k]);
+    refine_views.push_back(std::move(kept));
+    refine_of.push_back(patch_of[k]);
+  }
+  const std::vector<RefinedPatch> refined = RefineWith(*refiner_, to_refine, refine_views);
+
+  // 3. Accept on the views that pass threshold after optimisation.
+  std::vector<int> accepted_index;
+  for (size_t k = 0; k < refined.size(); ++k) {
+    const RefinedPatch& r = refined[k];
+    if (!std::isfinite(r.score)) continue;
+    AcceptedPatch a;
+    a.center = Eigen::Vector3d(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
+    a.normal = Eigen::Vector3d(r.patch.normal.s[0], r.patch.normal.s[1], r.patch.normal.s[2]);
+    a.ref = r.patch.reference;
+    // Refinement may turn the normal away from the images (up to the
+    // kernel's max angle); a patch seen that obliquely is not trusted.
+    if (!Faces(group_.images[a.ref].camera, a.center, a.normal, cos_max)) continue;
+    double sum = 0;
+    for (size_t v = 0; v < refine_views[k].size(); ++v) {
+      if (r.view_scores[v] >= options_.threshold &&
+          Faces(group_.images[refine_views[k][v]].camera, a.center, a.normal, cos_max)) {
+        a.views.push_back(refine_views[k][v]);
+        sum += r.view_scores[v];
+      }
+    }
+    if (static_cast<int>(a.views.size()) < need) continue;
+    a.score = static_cast<float>(sum / a.views.size());
+    a.size = options_.window_size;
+    results[refine_of[k]] = std::move(a);
+    accepted_index.push_back(refine_of[k]);
+  }
+  if (options_.mode != MatchMode::kSapmvs) return results;
+
+  // 4. Self-adaptive size: the largest patch that is still photo-consistent.
+  std::vector<int> open = accepted_index;
+  for (const int size : options_.adaptive_sizes) {
+    if (size <= options_.window_size || open.empty()) break;
+    std::vector<NccPatch> p;
+    std::vector<std::vector<int>> q;
+    for (const int i : open) {
+      const AcceptedPatch& a = *results[i];
+      p.push_back(MakeNccPatch(a.center, a.normal, a.ref));
+      q.push_back(a.views);
+    }
+    const std::vector<RefinedPatch> polished = RefineWith(*polishers_.at(size), p, q);
+    std::vector<int> still_open;
+    for (size_t k = 0; k < open.size(); ++k) {
+      AcceptedPatch& a = *results[open[k]];
+      const RefinedPatch& r = polished[k];
+      const Eigen::Vector3d c(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
+      const Eigen::Vector3d n(r.patch.normal.s[0], r.patch.normal.s[1], r.patch.normal.s[2]);
+      std::vector<int> pass;
+      double sum = 0;
+      const bool faces_ref = Faces(group_.images[a.ref].camera, c, n, cos_max);
+      for (size_t v = 0; v < q[k].size() && faces_ref; ++v) {
+        const float x = r.view_scores[v];
+        if (std::isfinite(x) && x >= options_.threshold &&
+            Faces(group_.images[q[k][v]].camera, c, n, cos_max)) {
+          pass.push_back(q[k][v]);
+          sum += x;
+        }
+      }
+      if (std::isfinite(r.score) && static_cast<int>(pass.size()) >= need) {
+        a.center = c;
+        a.normal = n;
+        a.size = size;
+        a.score = static_cast<float>(sum / pass.size());
+        a.views = std::move(pass);
+      } else {
+        still_open.push_back(open[k]);
+      }
+    }
+    open = std::move(still_open);
+  }
+  return results;
+}
+
+}  // namespace sapmvs

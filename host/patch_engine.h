@@ -1,0 +1,76 @@
+#pragma once
+// Evaluates batches of candidate patches on the device, the same way for
+// seeds and for every propagation wave (method.md 3.3, 4): pick the views a
+// candidate is visible in, keep those whose NCC reaches threshold_before,
+// refine depth and normal in-kernel, keep the views whose NCC then reaches
+// threshold, and accept the patch when they are at least min_image_num - 1.
+// In sapmvs mode an accepted patch is then scored at the adaptive sizes,
+// largest first (21, 15, 11, 7), each size one launch for the whole batch,
+// and takes the largest size at which it still passes. Each size first
+// polishes the patch at that size (a short refinement with small steps, one
+// launch per size): the 7 x 7 window constrains the normal too loosely to
+// extrapolate it over 21 pixels.
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "match_group.h"
+#include "ncc_scorer.h"
+#include "patch_refiner.h"
+#include "sapmvs/matcher.h"
+
+namespace sapmvs {
+
+struct PatchCandidate {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  // local frame
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  int ref = -1;
+};
+
+struct AcceptedPatch {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  int ref = -1;
+  std::vector<int> views;  // photo-consistent views, reference excluded
+  float score = 0;         // mean NCC over `views` at the accepted size
+  int size = 0;            // side of the accepted patch, pixels
+};
+
+class PatchEngine {
+ public:
+  PatchEngine(ClContext& context, const MatchGroupData& group, const MatcherOptions& options);
+
+  // One result per candidate, in order; nullopt = rejected.
+  std::vector<std::optional<AcceptedPatch>> Evaluate(const std::vector<PatchCandidate>& candidates);
+
+  // NCC of patches (centre, normal, ref) against `view`, window_size grid:
+  // for edge matching. NaN where undefined.
+  std::vector<float> Score(const std::vector<NccPatch>& patches, const std::vector<NccPair>& pairs);
+
+  // Kernel launches, items and device seconds so far (seconds are 0 without
+  // a profiling queue).
+  const std::map<std::string, KernelTime>& kernel_times() const { return kernel_times_; }
+
+ private:
+  std::vector<int> VisibleViews(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
+                                int ref, int half) const;
+  std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,
+                             const std::vector<NccPair>& pairs);
+  void Count(const std::string& kernel, long items, const ClEvent& event);
+  std::vector<RefinedPatch> RefineWith(PatchRefiner& refiner, const std::vector<NccPatch>& patches,
+                                       const std::vector<std::vector<int>>& views);
+
+  ClContext& context_;
+  const MatchGroupData& group_;
+  const MatcherOptions& options_;
+  std::shared_ptr<const NccDeviceGroup> device_group_;
+  std::map<int, std::unique_ptr<NccScorer>> scorers_;  // by patch side
+  std::unique_ptr<PatchRefiner> refiner_;
+  std::map<int, std::unique_ptr<PatchRefiner>> polishers_;  // by patch side (sapmvs)
+  std::map<std::string, KernelTime> kernel_times_;
+};
+
+}  // namespace sapmvs

@@ -1,0 +1,104 @@
+#include "sapmvs/surface_check.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sapmvs/error.h"
+
+namespace sapmvs {
+namespace {
+
+// Height of the raster cell under (x, y); NaN outside or empty.
+double CellHeight(const GeoRaster& r, double x, double y) {
+  const int col = static_cast<int>(std::floor((x - r.origin_x) / r.cell_size));
+  const int row = static_cast<int>(std::floor((r.origin_y - y) / r.cell_size));
+  if (col < 0 || row < 0 || col >= r.width || row >= r.height || r.IsEmpty(col, row))
+    return std::nan("");
+  return r.at(col, row);
+}
+
+// True when the segment from p towards `camera_center` passes below the
+// surface before it rises above `top`.
+bool Occluded(const GeoRaster& r, const Eigen::Vector3d& p, const Eigen::Vector3d& camera_center,
+              double top) {
+  const Eigen::Vector3d d = camera_center - p;
+  if (!(d.z() > 0)) return true;
+  const double horizontal = std::hypot(d.x(), d.y());
+  const double t_top = std::min(1.0, (top - p.z()) / d.z());
+  const double step = r.cell_size / std::max(horizontal, 1e-9);
+  // Start one cell away: the point's own cell (and its walls) do not hide it.
+  for (double t = 1.5 * step; t < t_top; t += step) {
+    const Eigen::Vector3d q = p + t * d;
+    const double h = CellHeight(r, q.x(), q.y());
+    if (std::isfinite(h) && h > q.z() + r.cell_size) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
+                                 const Block& block, const SurfaceCheckOptions& options) {
+  if (!(options.tolerance > 0) || !(options.cell_size > 0)) {
+    throw Error("surface check: tolerance and cell size must be > 0");
+  }
+  SurfaceCheck out;
+  out.points = static_cast<long>(cloud.points.size());
+  const double x0 = surface.origin_x, y0 = surface.origin_y;
+  const int cols =
+      static_cast<int>(std::floor(surface.width * surface.cell_size / options.cell_size));
+  const int rows =
+      static_cast<int>(std::floor(surface.height * surface.cell_size / options.cell_size));
+  std::vector<uint8_t> covered(static_cast<size_t>(cols) * rows, 0);
+  std::vector<double> abs_dz;
+  for (const CloudPoint& p : cloud.points) {
+    const double h = CellHeight(surface, p.position.x(), p.position.y());
+    if (!std::isfinite(h)) continue;
+    ++out.checked;
+    const double dz = std::abs(p.position.z() - h);
+    abs_dz.push_back(dz);
+    if (dz > options.tolerance) continue;
+    ++out.within;
+    const int c = static_cast<int>(std::floor((p.position.x() - x0) / options.cell_size));
+    const int r = static_cast<int>(std::floor((y0 - p.position.y()) / options.cell_size));
+    if (c >= 0 && r >= 0 && c < cols && r < rows) covered[static_cast<size_t>(r) * cols + c] = 1;
+  }
+  if (out.checked > 0) {
+    out.share_within = static_cast<double>(out.within) / out.checked;
+    std::nth_element(abs_dz.begin(), abs_dz.begin() + abs_dz.size() / 2, abs_dz.end());
+    out.median_abs_dz = abs_dz[abs_dz.size() / 2];
+  }
+  double top = -1e300;
+  for (size_t i = 0; i < surface.values.size(); ++i) {
+    if (std::isfinite(surface.values[i]) && surface.values[i] != surface.nodata) {
+      top = std::max(top, static_cast<double>(surface.values[i]));
+    }
+  }
+  long seen = 0, hit = 0;
+#pragma omp parallel for reduction(+ : seen, hit) schedule(dynamic, 8)
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const double x = x0 + (c + 0.5) * options.cell_size;
+      const double y = y0 - (r + 0.5) * options.cell_size;
+      const double h = CellHeight(surface, x, y);
+      if (!std::isfinite(h)) continue;
+      const Eigen::Vector3d p(x, y, h);
+      int views = 0;
+      for (const BlockImage& im : block.images) {
+        const Camera& cam = im.camera;
+        if (!(cam.Depth(p) > 0) || !cam.InImage(cam.ProjectDistorted(p))) continue;
+        if (Occluded(surface, p, cam.center(), top)) continue;
+        if (++views >= options.min_images) break;
+      }
+      if (views < options.min_images) continue;
+      ++seen;
+      if (covered[static_cast<size_t>(r) * cols + c]) ++hit;
+    }
+  }
+  out.cells_seen = seen;
+  out.cells_covered = hit;
+  out.coverage = seen > 0 ? static_cast<double>(hit) / seen : 0;
+  return out;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,134 @@
+#pragma once
+// Dense matching of one group of images (method.md 3 and 4): seeds from
+// Harris / DoG features matched along epipolar lines, propagation in waves
+// refined and scored on the OpenCL device, then filtering. Two modes share
+// the engine: `sapmvs` (the paper's self-adaptive patch) and `pmvs`
+// (Furukawa's one-patch-per-cell expansion).
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sapmvs/block.h"
+#include "sapmvs/ply_io.h"
+
+namespace sapmvs {
+
+class ClContext;
+
+enum class MatchMode { kSapmvs, kPmvs };
+std::string ToString(MatchMode mode);
+// Throws Error naming `text` unless it is "sapmvs" or "pmvs".
+MatchMode ParseMatchMode(const std::string& text);
+
+struct MatcherOptions {
+  MatchMode mode = MatchMode::kSapmvs;
+  // Pyramid level the group is matched at: 0 = full resolution, 1 = half
+  // (PMVS2's `level`), ... Each level halves both image sides.
+  int level = 1;
+  // Side of an image cell in pixels at `level` (PMVS2's `csize`): the grid
+  // that says which parts of an image are already covered.
+  int cell_size = 2;
+  // Mean NCC over the accepted views a patch needs after optimisation
+  // (PMVS2's `threshold`), and the per-view NCC a view needs to count.
+  double threshold = 0.7;
+  // Per-view NCC a view needs before optimisation to take part in it.
+  double threshold_before = 0.4;
+  // Images (reference included) a patch must be photo-consistent in
+  // (PMVS2's `minImageNum`), 2 to kMaxViews.
+  int min_image_num = 3;
+  // PMVS2's `maxAngle`, degrees: a view takes part in a reference's patches
+  // only if its line of sight meets the reference's at an angle of at least
+  // this (at the scene depth), so that it constrains depth.
+  double max_angle_deg = 10.0;
+  // Largest angle, degrees, between a patch normal and the direction to an
+  // image for that image to be a visible view of the patch.
+  double view_angle_deg = 60.0;
+  // Side of the matching window (PMVS2's `wsize`), pixels, odd: the patch
+  // refined by the device, and the smallest adaptive patch.
+  int window_size = 7;
+  // Self-adaptive patch sides tried in order, pixels, odd, decreasing, each
+  // <= kMaxPatchSize; the last must equal window_size (sapmvs mode).
+  std::vector<int> adaptive_sizes = {21, 15, 11, 7};
+  // Features kept per detector per 32 x 32 pixel block (PMVS: 4).
+  int features_per_block = 4;
+  // Candidate matches lie within this many pixels of the epipolar line.
+  double epipolar_distance = 2.0;
+  // Candidates tried per feature, best ordered first.
+  int candidates_per_feature = 4;
+  // Canny thresholds on 8-bit grey for edge points; edge pixels matched
+  // along epipolar lines become propagation barriers (sapmvs mode).
+  double canny_low = 40;
+  double canny_high = 120;
+  bool use_edges = true;
+  // Most candidate patches one device launch takes.
+  int max_wave = 16384;
+  // Waves stop after this many (0 = until the front is empty).
+  int max_waves = 0;
+  // Filtering: depth agreement tolerance, in pixel footprints.
+  double depth_tolerance = 3.0;
+  // Neighbourhood test: neighbours within this many footprints of a point.
+  double neighbour_radius = 4.0;
+  // A point needs this many neighbours, and must lie within plane_tolerance
+  // footprints of the plane they fit.
+  int min_neighbours = 4;
+  double plane_tolerance = 1.5;
+  // Clusters (points linked within neighbour_radius) smaller than this are
+  // removed.
+  int min_cluster_size = 30;
+  // Show progress on a terminal.
+  bool progress = true;
+
+  // Logs the first failing condition to stderr and returns false.
+  bool Check() const;
+  // The first failing condition as "what was expected (name = value)", or ""
+  // when the options are valid; for callers that report errors themselves.
+  std::string Problem() const;
+};
+
+// Wall and device time of one stage, seconds.
+struct StageTime {
+  double wall = 0;
+  double device = 0;
+};
+
+struct KernelTime {
+  long launches = 0;
+  long items = 0;  // patches or (patch, view) pairs
+  double seconds = 0;
+};
+
+struct MatchStats {
+  int images = 0;
+  long features = 0;
+  long seeds_tried = 0;
+  long seeds_accepted = 0;
+  long edge_points = 0;
+  long matched_edge_points = 0;
+  long candidates = 0;  // patches refined during propagation
+  long patches = 0;     // accepted (seeds + propagation)
+  long waves = 0;
+  long largest_wave = 0;
+  std::map<int, long> accepted_by_size;  // sapmvs: patch side -> accepted patches
+  long points_before_filter = 0;
+  long removed_visibility = 0;
+  long removed_neighbourhood = 0;
+  long removed_clusters = 0;
+  long points = 0;
+  std::vector<std::pair<std::string, StageTime>> stages;  // in order
+  std::map<std::string, KernelTime> kernels;
+  double gsd = 0;  // median footprint of a pixel at the working level, block units
+};
+
+struct MatchResult {
+  PointCloud cloud;  // world coordinates (the local origin added back)
+  MatchStats stats;
+};
+
+// Matches images `image_ids` of `block` (all when empty). Throws Error for
+// bad options, unreadable images or fewer than 2 usable images.
+MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
+                       const MatcherOptions& options, ClContext& context);
+
+}  // namespace sapmvs

@@ -1,0 +1,40 @@
+#pragma once
+// Accuracy and coverage of a cloud against a true surface raster (the
+// simulator's truth/dsm.tif): the acceptance measure of the matcher.
+//  - accuracy: the share of points within `tolerance` of the surface,
+//    vertically, the surface read at the cell under the point (the truth DSM
+//    is flat-topped cells, so no interpolation across walls);
+//  - coverage: the ground is cut into cells of `cell_size`; a cell is "seen"
+//    when the surface at its centre projects into at least `min_images`
+//    images unoccluded (a ray march through the raster), and "covered" when
+//    it holds a point within `tolerance`.
+#include <vector>
+
+#include "sapmvs/block.h"
+#include "sapmvs/ply_io.h"
+#include "sapmvs/raster_io.h"
+
+namespace sapmvs {
+
+struct SurfaceCheckOptions {
+  double tolerance = 0;  // block units, > 0 (e.g. one GSD)
+  double cell_size = 0;  // block units, > 0 (e.g. the matcher's cell footprint)
+  int min_images = 3;
+};
+
+struct SurfaceCheck {
+  long points = 0;
+  long checked = 0;  // points over a non-empty surface cell
+  long within = 0;
+  double share_within = 0;  // within / checked
+  double median_abs_dz = 0;
+  long cells_seen = 0;
+  long cells_covered = 0;
+  double coverage = 0;  // covered / seen
+};
+
+// Throws Error for non-positive tolerance or cell size.
+SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
+                                 const Block& block, const SurfaceCheckOptions& options);
+
+}  // namespace sapmvs

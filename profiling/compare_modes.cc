@@ -1,0 +1,125 @@
+// SAPMVS against PMVS on one block, in one run (method.md 3.4; the paper's
+// Tables 4 and 6): wall time, points, accuracy and coverage against the true
+// surface, and the ratios. Both modes share one OpenCL context, so kernels
+// are compiled before the first timing starts.
+//
+//   compare_modes BLOCK --truth DSM [--level N] [--csv FILE]
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include "cl_runtime.h"
+#include "sapmvs/block_geometry.h"
+#include "sapmvs/block_reader.h"
+#include "sapmvs/error.h"
+#include "sapmvs/matcher.h"
+#include "sapmvs/raster_io.h"
+#include "sapmvs/surface_check.h"
+
+using namespace sapmvs;
+
+struct Row {
+  std::string mode;
+  double seconds = 0, kernel_seconds = 0;
+  long points = 0;
+  SurfaceCheck check;
+};
+
+int main(int argc, char** argv) {
+  CLI::App app("SAPMVS vs PMVS on one block, against its true surface");
+  std::string block_path, truth_path, csv_path, device;
+  int level = 1;
+  bool both_tolerances = false;
+  app.add_option("block", block_path, "Block file or folder")->required();
+  app.add_option("--truth", truth_path, "True surface raster (truth/dsm.tif)")->required();
+  app.add_option("--level", level, "Pyramid level")->capture_default_str();
+  app.add_option("--device", device, "OpenCL device");
+  app.add_option("--csv", csv_path, "Write the rows as CSV");
+  app.add_flag("--working-gsd", both_tolerances,
+               "Also report accuracy within 1 GSD of the working level");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const Block block = ReadBlock(block_path);
+    const GeoRaster truth = ReadGeoRaster(truth_path);
+    const double gsd = EstimateBlockGeometry(block).gsd_median;  // full resolution
+    DeviceOptions dev;
+    dev.device = device;
+    dev.profile = true;
+    ClContext context(dev);
+    std::vector<Row> rows;
+    for (const MatchMode mode : {MatchMode::kPmvs, MatchMode::kSapmvs}) {
+      MatcherOptions o;
+      o.mode = mode;
+      o.level = level;
+      o.progress = false;
+      if (mode == MatchMode::kPmvs) o.adaptive_sizes = {o.window_size};
+      // Warm-up on a tiny budget compiles every kernel of this mode.
+      MatcherOptions warm = o;
+      warm.max_waves = 1;
+      warm.use_edges = false;
+      (void)MatchGroup(block, {}, warm, context);
+      const auto start = std::chrono::steady_clock::now();
+      const MatchResult r = MatchGroup(block, {}, o, context);
+      Row row;
+      row.mode = ToString(mode);
+      row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      for (const auto& [name, t] : r.stats.kernels) row.kernel_seconds += t.seconds;
+      row.points = r.stats.points;
+      SurfaceCheckOptions so;
+      so.tolerance = gsd;
+      so.cell_size = o.cell_size * std::ldexp(1.0, level) * gsd;
+      row.check = CheckAgainstSurface(r.cloud, truth, block, so);
+      if (const char* dump = std::getenv("SAPMVS_DUMP_DZ")) {
+        std::ofstream d(std::string(dump) + "_" + row.mode + ".txt");
+        for (const CloudPoint& cp : r.cloud.points) {
+          const int col = static_cast<int>((cp.position.x() - truth.origin_x) / truth.cell_size);
+          const int rr = static_cast<int>((truth.origin_y - cp.position.y()) / truth.cell_size);
+          if (col < 0 || rr < 0 || col >= truth.width || rr >= truth.height) continue;
+          d << cp.position.x() << " " << cp.position.y() << " "
+            << cp.position.z() - truth.at(col, rr) << " " << cp.normal.z() << " " << cp.score << " "
+            << cp.num_views << "\n";
+        }
+      }
+      rows.push_back(row);
+      std::cerr << row.mode << ": " << r.stats.patches << " patches, " << r.stats.waves
+                << " waves, " << r.stats.candidates << " candidates, filter "
+                << r.stats.points_before_filter << " -> " << r.stats.points << "\n";
+    }
+    std::cout << "block " << block_path << ", level " << level << ", GSD " << gsd
+              << " (tolerance 1 GSD; coverage cells of " << 2 * std::ldexp(1.0, level) * gsd
+              << ")\n";
+    std::cout << std::left << std::setw(8) << "mode" << std::right << std::setw(10) << "wall s"
+              << std::setw(11) << "kernel s" << std::setw(10) << "points" << std::setw(12)
+              << "<=1 GSD" << std::setw(12) << "median|dz|" << std::setw(11) << "coverage"
+              << "\n";
+    for (const Row& r : rows) {
+      std::cout << std::left << std::setw(8) << r.mode << std::right << std::fixed
+                << std::setprecision(2) << std::setw(10) << r.seconds << std::setw(11)
+                << r.kernel_seconds << std::setw(10) << r.points << std::setw(11)
+                << std::setprecision(1) << 100 * r.check.share_within << "%" << std::setw(12)
+                << std::setprecision(3) << r.check.median_abs_dz << std::setw(10)
+                << std::setprecision(1) << 100 * r.check.coverage << "%\n";
+    }
+    const Row& p = rows[0];
+    const Row& s = rows[1];
+    std::cout << std::setprecision(2) << "sapmvs/pmvs: speed " << p.seconds / s.seconds
+              << "x, points " << static_cast<double>(s.points) / p.points << "x\n";
+    if (!csv_path.empty()) {
+      std::ofstream csv(csv_path);
+      csv << "mode,wall_s,kernel_s,points,within_1gsd,median_abs_dz,coverage\n";
+      for (const Row& r : rows) {
+        csv << r.mode << "," << r.seconds << "," << r.kernel_seconds << "," << r.points << ","
+            << r.check.share_within << "," << r.check.median_abs_dz << "," << r.check.coverage
+            << "\n";
+      }
+    }
+  } catch (const Error& e) {
+    std::cerr << "compare_modes: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,210 @@
+#include "sapmvs/surface_check.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "sapmvs/block.h"
+#include "sapmvs/error.h"
+
+namespace sapmvs {
+namespace {
+
+// A flat surface at height 10: 200 x 200 cells of 0.5, i.e. x in [1000, 1100]
+// and y in [2000, 2100].
+constexpr double kX0 = 1000, kY0 = 2100, kZ = 10;
+constexpr int kRasterCells = 200;
+constexpr double kRasterCell = 0.5;
+// The check's cells: 2 x 2, i.e. 50 x 50 of them over the raster.
+constexpr double kCell = 2.0;
+constexpr int kCheckCells = 50;
+constexpr double kTolerance = 0.3;
+
+GeoRaster FlatSurface() {
+  GeoRaster r;
+  r.width = r.height = kRasterCells;
+  r.origin_x = kX0;
+  r.origin_y = kY0;
+  r.cell_size = kRasterCell;
+  r.values.assign(static_cast<size_t>(kRasterCells) * kRasterCells, static_cast<float>(kZ));
+  return r;
+}
+
+// Nadir pinhole cameras 100 above the surface near its centre; each image
+// (400 x 400 px, f = 150 px) covers 267 x 267, so every camera sees it all.
+Block NadirBlock(int num_cameras) {
+  Block block;
+  block.format = "yaml";
+  Eigen::Matrix3d r_wc;
+  r_wc.row(0) = Eigen::Vector3d(1, 0, 0);
+  r_wc.row(1) = Eigen::Vector3d(0, -1, 0);
+  r_wc.row(2) = Eigen::Vector3d(0, 0, -1);
+  const Intrinsics k = Intrinsics::FromPixels(150, 150, 199.5, 199.5, 400, 400);
+  for (int i = 0; i < num_cameras; ++i) {
+    BlockImage im;
+    im.name = "IMG_" + std::to_string(i);
+    im.camera_name = "cam";
+    im.camera = Camera(k, r_wc, Eigen::Vector3d(1045 + 5 * i, 2048 + 2 * (i % 2), kZ + 100));
+    block.images.push_back(im);
+  }
+  block.origin = ChooseLocalOrigin(block.images);
+  return block;
+}
+
+// One point at the centre of every check cell, on the surface.
+PointCloud PointPerCell() {
+  PointCloud cloud;
+  for (int r = 0; r < kCheckCells; ++r) {
+    for (int c = 0; c < kCheckCells; ++c) {
+      CloudPoint p;
+      p.position = {kX0 + (c + 0.5) * kCell, kY0 - (r + 0.5) * kCell, kZ};
+      cloud.points.push_back(p);
+    }
+  }
+  return cloud;
+}
+
+SurfaceCheckOptions Options() {
+  SurfaceCheckOptions o;
+  o.tolerance = kTolerance;
+  o.cell_size = kCell;
+  o.min_images = 3;
+  return o;
+}
+
+TEST(CheckAgainstSurface, PointsOnTheSurfaceEverywhereAreAllWithinAndCoverAll) {
+  const PointCloud cloud = PointPerCell();
+  const SurfaceCheck s = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), Options());
+  EXPECT_EQ(s.points, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.checked, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.within, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.share_within, 1.0);
+  EXPECT_EQ(s.median_abs_dz, 0.0);
+  // Flat and seen by all three cameras: every cell is seen.
+  EXPECT_EQ(s.cells_seen, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.cells_covered, s.cells_seen);
+  EXPECT_EQ(s.coverage, 1.0);
+}
+
+TEST(CheckAgainstSurface, HalfThePointsTwoTolerancesUpHalveShareAndCoverage) {
+  PointCloud cloud = PointPerCell();
+  for (size_t i = 0; i < cloud.points.size(); i += 2)
+    cloud.points[i].position.z() += 2 * kTolerance;
+  const SurfaceCheck s = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), Options());
+  EXPECT_EQ(s.checked, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.within, kCheckCells * kCheckCells / 2);
+  EXPECT_EQ(s.share_within, 0.5);
+  // Half are at 0, half at 2 tolerances: the median is one or the other.
+  EXPECT_TRUE(s.median_abs_dz == 0.0 || std::abs(s.median_abs_dz - 2 * kTolerance) < 1e-6)
+      << s.median_abs_dz;
+  // A cell whose only point is off the surface is not covered.
+  EXPECT_EQ(s.cells_seen, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.cells_covered, kCheckCells * kCheckCells / 2);
+  EXPECT_EQ(s.coverage, 0.5);
+}
+
+TEST(CheckAgainstSurface, PointsJustInsideTheToleranceCount) {
+  PointCloud cloud = PointPerCell();
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    cloud.points[i].position.z() += (i % 2 == 0 ? 0.9 : -0.9) * kTolerance;
+  }
+  const SurfaceCheck s = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), Options());
+  EXPECT_EQ(s.share_within, 1.0);
+  EXPECT_NEAR(s.median_abs_dz, 0.9 * kTolerance, 1e-6);
+  EXPECT_EQ(s.coverage, 1.0);
+}
+
+TEST(CheckAgainstSurface, RemovingTheCellsOfAKnownSetLowersCoverageByItsShare) {
+  // Drop the points of the 12 leftmost columns of cells and of a 5 x 7 patch
+  // elsewhere; add a second point to some remaining cells (no effect on
+  // coverage) and points outside the surface (not checked).
+  PointCloud cloud;
+  long removed = 0;
+  for (const CloudPoint& p : PointPerCell().points) {
+    const int c = static_cast<int>(std::floor((p.position.x() - kX0) / kCell));
+    const int r = static_cast<int>(std::floor((kY0 - p.position.y()) / kCell));
+    if (c < 12 || (c >= 30 && c < 35 && r >= 20 && r < 27)) {
+      ++removed;
+      continue;
+    }
+    cloud.points.push_back(p);
+    if ((r + c) % 3 == 0) {
+      CloudPoint q = p;
+      q.position += Eigen::Vector3d(0.3, -0.4, 0.05);
+      cloud.points.push_back(q);
+    }
+  }
+  ASSERT_EQ(removed, 12 * kCheckCells + 5 * 7);
+  const long on_surface = static_cast<long>(cloud.points.size());
+  for (int i = 0; i < 7; ++i) {
+    CloudPoint p;
+    p.position = {kX0 - 5 - i, kY0 + 3, kZ};  // west of and north of the raster
+    cloud.points.push_back(p);
+  }
+  const SurfaceCheck s = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(4), Options());
+  EXPECT_EQ(s.points, on_surface + 7);
+  EXPECT_EQ(s.checked, on_surface);
+  EXPECT_EQ(s.within, on_surface);
+  ASSERT_GT(s.cells_seen, 0);
+  EXPECT_EQ(s.cells_covered, s.cells_seen - removed);
+  EXPECT_DOUBLE_EQ(s.coverage, static_cast<double>(s.cells_seen - removed) / s.cells_seen);
+  EXPECT_EQ(s.cells_seen, kCheckCells * kCheckCells);
+}
+
+TEST(CheckAgainstSurface, CellsSeenByFewerThanMinImagesAreNotCounted) {
+  SurfaceCheckOptions o = Options();
+  o.min_images = 4;
+  const SurfaceCheck three = CheckAgainstSurface(PointPerCell(), FlatSurface(), NadirBlock(3), o);
+  EXPECT_EQ(three.cells_seen, 0);
+  EXPECT_EQ(three.coverage, 0.0);
+  // The accuracy part does not depend on the cameras.
+  EXPECT_EQ(three.share_within, 1.0);
+  const SurfaceCheck four = CheckAgainstSurface(PointPerCell(), FlatSurface(), NadirBlock(4), o);
+  EXPECT_EQ(four.cells_seen, kCheckCells * kCheckCells);
+}
+
+TEST(CheckAgainstSurface, EmptySurfaceCellsAreNeitherCheckedNorSeen) {
+  GeoRaster surface = FlatSurface();
+  // Empty the west half (x < 1050): 100 raster columns, 25 check columns.
+  for (int row = 0; row < kRasterCells; ++row) {
+    for (int col = 0; col < kRasterCells / 2; ++col) {
+      surface.at(col, row) = (row % 2 == 0) ? std::numeric_limits<float>::quiet_NaN() : -9999.0f;
+    }
+  }
+  surface.nodata = -9999.0f;
+  const SurfaceCheck s = CheckAgainstSurface(PointPerCell(), surface, NadirBlock(3), Options());
+  EXPECT_EQ(s.points, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.checked, kCheckCells * kCheckCells / 2);
+  EXPECT_EQ(s.cells_seen, kCheckCells * kCheckCells / 2);
+  EXPECT_EQ(s.coverage, 1.0);
+}
+
+TEST(CheckAgainstSurface, EmptyCloudHasNoShareAndNoCoverage) {
+  const SurfaceCheck s = CheckAgainstSurface(PointCloud{}, FlatSurface(), NadirBlock(3), Options());
+  EXPECT_EQ(s.points, 0);
+  EXPECT_EQ(s.checked, 0);
+  EXPECT_EQ(s.share_within, 0.0);
+  EXPECT_EQ(s.cells_seen, kCheckCells * kCheckCells);
+  EXPECT_EQ(s.cells_covered, 0);
+  EXPECT_EQ(s.coverage, 0.0);
+}
+
+TEST(CheckAgainstSurface, BadOptionsThrow) {
+  const PointCloud cloud = PointPerCell();
+  const GeoRaster surface = FlatSurface();
+  const Block block = NadirBlock(3);
+  for (const double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    SurfaceCheckOptions o = Options();
+    o.tolerance = bad;
+    EXPECT_THROW(CheckAgainstSurface(cloud, surface, block, o), Error) << "tolerance " << bad;
+    o = Options();
+    o.cell_size = bad;
+    EXPECT_THROW(CheckAgainstSurface(cloud, surface, block, o), Error) << "cell_size " << bad;
+  }
+}
+
+}  // namespace
+}  // namespace sapmvs
