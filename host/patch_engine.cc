@@ -91,6 +91,15 @@ std::vector<float> PatchEngine::Score(const std::vector<NccPatch>& patches,
   return ScoreAt(options_.window_size, patches, pairs);
 }
 
+bool PatchEngine::OnParentPlane(const PatchCandidate& candidate,
+                                const Eigen::Vector3d& center) const {
+  if (!candidate.has_parent) return true;
+  const Camera& cam = group_.images[candidate.ref].camera;
+  const double footprint = cam.Depth(center) / cam.intrinsics().MeanFocal();
+  return std::abs(candidate.parent_normal.dot(center - candidate.parent_center)) <=
+         options_.depth_tolerance * footprint;
+}
+
 std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
                                            const Eigen::Vector3d& normal, int ref, int half) const {
   const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
@@ -166,6 +175,7 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
     // Refinement may turn the normal away from the images (up to the
     // kernel's max angle); a patch seen that obliquely is not trusted.
     if (!Faces(group_.images[a.ref].camera, a.center, a.normal, cos_max)) continue;
+    if (!OnParentPlane(candidates[refine_of[k]], a.center)) continue;
     double sum = 0;
     for (size_t v = 0; v < refine_views[k].size(); ++v) {
       if (r.view_scores[v] >= options_.threshold &&
@@ -202,7 +212,8 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
       const Eigen::Vector3d n(r.patch.normal.s[0], r.patch.normal.s[1], r.patch.normal.s[2]);
       std::vector<int> pass;
       double sum = 0;
-      const bool faces_ref = Faces(group_.images[a.ref].camera, c, n, cos_max);
+      const bool faces_ref = Faces(group_.images[a.ref].camera, c, n, cos_max) &&
+                             OnParentPlane(candidates[open[k]], c);
       for (size_t v = 0; v < q[k].size() && faces_ref; ++v) {
         const float x = r.view_scores[v];
         if (std::isfinite(x) && x >= options_.threshold &&

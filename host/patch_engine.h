@@ -28,6 +28,13 @@ struct PatchCandidate {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // local frame
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   int ref = -1;
+  // Expansion candidates: the plane of the patch they grew from. The refined
+  // patch must stay within depth_tolerance footprints of it, else the
+  // refinement jumped to another surface (or a false match) and the
+  // expansion stops there; seeds (no parent) are not constrained.
+  bool has_parent = false;
+  Eigen::Vector3d parent_center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d parent_normal = Eigen::Vector3d::UnitZ();
 };
 
 struct AcceptedPatch {
@@ -55,6 +62,7 @@ class PatchEngine {
   const std::map<std::string, KernelTime>& kernel_times() const { return kernel_times_; }
 
  private:
+  bool OnParentPlane(const PatchCandidate& candidate, const Eigen::Vector3d& center) const;
   std::vector<int> VisibleViews(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
                                 int ref, int half) const;
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,

@@ -151,8 +151,33 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     const Eigen::Vector3d normal = es.eigenvectors().col(0);
     pass[a] = std::abs(normal.dot(p.x - mean)) <= options.plane_tolerance * fp;
   }
+  // 2b. Patch support: the points of other patches next to a patch must lie
+  // on its plane. A sapmvs patch emits hundreds of points on one plane, which
+  // all pass test 2 among themselves however wrong the plane is; its
+  // neighbours are the independent evidence. A majority is asked for, not
+  // all, so a roof patch survives ground neighbours along its edge.
+  std::vector<int> foreign(patches.size(), 0), consistent(patches.size(), 0);
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    const AcceptedPatch& patch = patches[p.patch];
+    const double fp = Footprint(group.images[patch.ref].camera, p.x);
+    for (int j = 0; j < k; ++j) {
+      const size_t b = nn[a * k + j];
+      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const DensePoint& q = points[alive[b]];
+      if (q.patch == p.patch) continue;
+      ++foreign[p.patch];
+      if (std::abs(patch.normal.dot(q.x - patch.center)) <= options.plane_tolerance * fp) {
+        ++consistent[p.patch];
+      }
+    }
+  }
+  auto supported = [&](int id) {
+    return foreign[id] >= options.min_neighbours && 2 * consistent[id] >= foreign[id];
+  };
   long removed_plane = 0;
   for (size_t a = 0; a < alive.size(); ++a) {
+    if (pass[a] && !supported(points[alive[a]].patch)) pass[a] = 0;
     if (!pass[a]) {
       keep[alive[a]] = false;
       ++removed_plane;

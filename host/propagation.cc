@@ -148,6 +148,9 @@ void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
     cand.center = c;
     cand.normal = patch.normal;
     cand.ref = patch.ref;
+    cand.has_parent = true;
+    cand.parent_center = patch.center;
+    cand.parent_normal = patch.normal;
     front->push_back(cand);
   };
   if (options_.mode == MatchMode::kPmvs) {

@@ -33,14 +33,21 @@ int main(int argc, char** argv) {
   CLI::App app("SAPMVS vs PMVS on one block, against its true surface");
   std::string block_path, truth_path, csv_path, device;
   int level = 1;
-  bool both_tolerances = false;
   app.add_option("block", block_path, "Block file or folder")->required();
   app.add_option("--truth", truth_path, "True surface raster (truth/dsm.tif)")->required();
   app.add_option("--level", level, "Pyramid level")->capture_default_str();
   app.add_option("--device", device, "OpenCL device");
   app.add_option("--csv", csv_path, "Write the rows as CSV");
-  app.add_flag("--working-gsd", both_tolerances,
-               "Also report accuracy within 1 GSD of the working level");
+  std::string only;
+  MatcherOptions base;
+  app.add_option("--only", only, "Run one mode: sapmvs or pmvs");
+  app.add_option("--threshold", base.threshold, "MatcherOptions::threshold");
+  app.add_option("--view-angle", base.view_angle_deg, "MatcherOptions::view_angle_deg");
+  app.add_option("--min-image-num", base.min_image_num, "MatcherOptions::min_image_num");
+  app.add_option("--depth-tolerance", base.depth_tolerance, "MatcherOptions::depth_tolerance");
+  app.add_option("--plane-tolerance", base.plane_tolerance, "MatcherOptions::plane_tolerance");
+  app.add_option("--adaptive-sizes", base.adaptive_sizes, "MatcherOptions::adaptive_sizes")
+      ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   try {
     const Block block = ReadBlock(block_path);
@@ -51,12 +58,13 @@ int main(int argc, char** argv) {
     dev.profile = true;
     ClContext context(dev);
     std::vector<Row> rows;
-    for (const MatchMode mode : {MatchMode::kPmvs, MatchMode::kSapmvs}) {
-      MatcherOptions o;
+    std::vector<MatchMode> modes = {MatchMode::kPmvs, MatchMode::kSapmvs};
+    if (!only.empty()) modes = {ParseMatchMode(only)};
+    for (const MatchMode mode : modes) {
+      MatcherOptions o = base;
       o.mode = mode;
       o.level = level;
       o.progress = false;
-      if (mode == MatchMode::kPmvs) o.adaptive_sizes = {o.window_size};
       // Warm-up on a tiny budget compiles every kernel of this mode.
       MatcherOptions warm = o;
       warm.max_waves = 1;
@@ -79,7 +87,7 @@ int main(int argc, char** argv) {
           const int col = static_cast<int>((cp.position.x() - truth.origin_x) / truth.cell_size);
           const int rr = static_cast<int>((truth.origin_y - cp.position.y()) / truth.cell_size);
           if (col < 0 || rr < 0 || col >= truth.width || rr >= truth.height) continue;
-          d << cp.position.x() << " " << cp.position.y() << " "
+          d << std::setprecision(12) << cp.position.x() << " " << cp.position.y() << " "
             << cp.position.z() - truth.at(col, rr) << " " << cp.normal.z() << " " << cp.score << " "
             << cp.num_views << "\n";
         }
@@ -104,10 +112,12 @@ int main(int argc, char** argv) {
                 << std::setprecision(3) << r.check.median_abs_dz << std::setw(10)
                 << std::setprecision(1) << 100 * r.check.coverage << "%\n";
     }
-    const Row& p = rows[0];
-    const Row& s = rows[1];
-    std::cout << std::setprecision(2) << "sapmvs/pmvs: speed " << p.seconds / s.seconds
-              << "x, points " << static_cast<double>(s.points) / p.points << "x\n";
+    if (rows.size() == 2) {
+      const Row& p = rows[0];
+      const Row& s = rows[1];
+      std::cout << std::setprecision(2) << "sapmvs/pmvs: speed " << p.seconds / s.seconds
+                << "x, points " << static_cast<double>(s.points) / p.points << "x\n";
+    }
     if (!csv_path.empty()) {
       std::ofstream csv(csv_path);
       csv << "mode,wall_s,kernel_s,points,within_1gsd,median_abs_dz,coverage\n";
