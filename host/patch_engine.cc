@@ -204,9 +204,17 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
       q.push_back(a.views);
     }
     const std::vector<RefinedPatch> polished = RefineWith(*polishers_.at(size), p, q);
+    // Patches that pass at this size, before the corner test.
+    struct Pass {
+      size_t k;
+      Eigen::Vector3d c, n;
+      std::vector<int> views;
+      double score;
+    };
+    std::vector<Pass> passing;
     std::vector<int> still_open;
     for (size_t k = 0; k < open.size(); ++k) {
-      AcceptedPatch& a = *results[open[k]];
+      const AcceptedPatch& a = *results[open[k]];
       const RefinedPatch& r = polished[k];
       const Eigen::Vector3d c(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
       const Eigen::Vector3d n(r.patch.normal.s[0], r.patch.normal.s[1], r.patch.normal.s[2]);
@@ -223,14 +231,67 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
         }
       }
       if (std::isfinite(r.score) && static_cast<int>(pass.size()) >= need) {
-        a.center = c;
-        a.normal = n;
-        a.size = size;
-        a.score = static_cast<float>(sum / pass.size());
-        a.views = std::move(pass);
+        const double mean = sum / static_cast<double>(pass.size());
+        passing.push_back(Pass{k, c, n, std::move(pass), mean});
       } else {
         still_open.push_back(open[k]);
       }
+    }
+    // The plane must fit in each corner of the large patch too: a patch
+    // straddling a roof edge or a break of slope scores well over its whole
+    // window (the fitting part dominates) but not in the corner that lies on
+    // the other surface.
+    const double offset = 0.5 * (size - options_.window_size);
+    std::vector<NccPatch> corners;
+    std::vector<NccPair> corner_pairs;
+    std::vector<bool> corner_ok(passing.size(), true);
+    std::vector<size_t> corner_of;  // passing index of corners[i]
+    for (size_t j = 0; j < passing.size(); ++j) {
+      const Pass& ps = passing[j];
+      const Camera& ref = group_.images[results[open[ps.k]]->ref].camera;
+      const Eigen::Vector2d uv = ref.Project(ps.c);
+      for (const auto& d : {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(-1, 1),
+                            Eigen::Vector2d(1, 1), Eigen::Vector2d(0, -1), Eigen::Vector2d(0, 1),
+                            Eigen::Vector2d(-1, 0), Eigen::Vector2d(1, 0)}) {
+        const Eigen::Vector3d ray = ref.Ray(uv + offset * d);
+        const double den = ps.n.dot(ray);
+        const double s = ps.n.dot(ps.c - ref.center()) / den;
+        if (!std::isfinite(s) || s <= 0) {
+          corner_ok[j] = false;
+          continue;
+        }
+        const int idx = static_cast<int>(corners.size());
+        corners.push_back(MakeNccPatch(ref.center() + s * ray, ps.n, results[open[ps.k]]->ref));
+        corner_of.push_back(j);
+        for (const int v : ps.views) corner_pairs.push_back(NccPair{idx, v});
+      }
+    }
+    const std::vector<float> corner_scores = ScoreAt(options_.window_size, corners, corner_pairs);
+    std::vector<double> corner_sum(corners.size(), 0.0);
+    std::vector<int> corner_n(corners.size(), 0);
+    for (size_t i = 0; i < corner_pairs.size(); ++i) {
+      const float x = corner_scores[i];
+      if (!std::isfinite(x)) continue;  // no texture there: no evidence either way
+      corner_sum[corner_pairs[i].patch] += x;
+      ++corner_n[corner_pairs[i].patch];
+    }
+    for (size_t i = 0; i < corners.size(); ++i) {
+      if (corner_n[i] > 0 && corner_sum[i] / corner_n[i] < options_.threshold) {
+        corner_ok[corner_of[i]] = false;
+      }
+    }
+    for (size_t j = 0; j < passing.size(); ++j) {
+      Pass& ps = passing[j];
+      if (!corner_ok[j]) {
+        still_open.push_back(open[ps.k]);
+        continue;
+      }
+      AcceptedPatch& a = *results[open[ps.k]];
+      a.center = ps.c;
+      a.normal = ps.n;
+      a.size = size;
+      a.score = static_cast<float>(ps.score);
+      a.views = std::move(ps.views);
     }
     open = std::move(still_open);
   }

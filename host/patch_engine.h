@@ -9,7 +9,12 @@
 // and takes the largest size at which it still passes. Each size first
 // polishes the patch at that size (a short refinement with small steps, one
 // launch per size): the 7 x 7 window constrains the normal too loosely to
-// extrapolate it over 21 pixels.
+// extrapolate it over 21 pixels. A size is only taken when, in addition, the
+// polished plane scores >= threshold in each of the 8 window_size sub-windows
+// along the patch border (corners and edge midpoints): a large window that
+// straddles a roof edge passes on its dominant part alone, and would emit
+// roof-height points over the ground beside it (on the city preset the test
+// raised the share within 1 m of the LiDAR from 54.5 % to 70.8 %).
 #include <Eigen/Core>
 #include <map>
 #include <memory>

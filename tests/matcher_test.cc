@@ -243,15 +243,15 @@ class MatchGroupTest : public test::ClTest {
 
 // Acceptance floors against truth/dsm.tif. Measured on PoCL (tiny preset,
 // seed 1, level 1, min_image_num 2):
-//   sapmvs: 72560 points, share within 2 GSD 0.589, median |dz| 1.035 GSD,
-//           coverage 0.652;
-//   pmvs:   18205 points, share within 2 GSD 0.868, median |dz| 0.303 GSD,
-//           coverage 0.784;
+//   sapmvs: 67774 points, share within 2 GSD 0.774, median |dz| 0.497 GSD,
+//           coverage 0.763 (0.636 / 0.790 GSD / 0.622 before large patches
+//           had to fit in each of their 8 border sub-windows);
+//   pmvs:   18130 points, share within 2 GSD 0.871, median |dz| 0.300 GSD,
+//           coverage 0.785;
 //   a random cloud of the same size and extent: share 0.01 to 0.04,
-//   coverage 0.04 to 0.07.
-// The pmvs floors sit well below its measurements; the sapmvs ones are the
-// project's acceptance floor (share >= 0.6, median < 1 GSD), which the
-// self-adaptive mode must reach.
+//   coverage 0.03 to 0.07.
+// The floors sit below the measurements by a margin for PoCL builds on other
+// CPUs; the sapmvs ones fail if the sub-window test is lost.
 struct Floors {
   long points;
   double share_within;
@@ -285,7 +285,7 @@ TEST_F(MatchGroupTest, SapmvsModeMatchesTheTrueSurface) {
               o.adaptive_sizes.end())
         << size;
   }
-  ExpectMeetsFloors(m, {30000, 0.6, 1.0, 0.5});
+  ExpectMeetsFloors(m, {30000, 0.7, 0.7, 0.68});
   ExpectPointsWellFormed(m.result.cloud, o);
 }
 
