@@ -4,6 +4,12 @@
 // Callbacks throw sapmvs::Error on failure; main() turns that into one line on
 // stderr and the error's exit code.
 
+#include <limits>
+#include <string>
+
+#include "sapmvs/block.h"
+#include "sapmvs/block_reader.h"
+
 namespace CLI {
 class App;
 }
@@ -15,10 +21,22 @@ struct GlobalFlags {
   bool quiet = false;  // No progress output, even on a terminal.
 };
 
+// How a subcommand reads its BLOCK argument: --format, --image-dir,
+// --no-size-check, --ground-height, the same for every subcommand.
+struct BlockFlags {
+  std::string format = "auto";
+  BlockReadOptions read;
+  double ground_height = std::numeric_limits<double>::quiet_NaN();
+};
+void AddBlockFlags(CLI::App* cmd, BlockFlags* flags);
+// Reads `path` as the flags say; throws Error for a bad flag value.
+Block ReadBlockWithFlags(const std::string& path, BlockFlags& flags);
+
 void RegisterDevicesCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterInfoCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterRunCommand(CLI::App& app, const GlobalFlags& global);
+void RegisterPlanCommand(CLI::App& app, const GlobalFlags& global);
 
 }  // namespace sapmvs::cli

@@ -19,9 +19,7 @@ namespace {
 
 struct InfoArgs {
   std::string block;
-  std::string format = "auto";
-  BlockReadOptions read;
-  double ground_height = std::numeric_limits<double>::quiet_NaN();
+  BlockFlags flags;
 };
 
 std::string Fmt(const char* fmt, double a, double b = 0, double c = 0) {
@@ -112,24 +110,33 @@ void RegisterInfoCommand(CLI::App& app, const GlobalFlags& /*global*/) {
   cmd->add_option("block", args->block,
                   "Block: block.yaml, PMVS/COLMAP/Strecha folder, or OpenSfM json")
       ->required();
-  cmd->add_option("--format", args->format,
-                  "Block format: auto, yaml, pmvs, colmap, strecha, opensfm")
-      ->capture_default_str();
-  cmd->add_option("--image-dir", args->read.image_dir,
-                  "Folder holding the images (overrides the block's)");
-  cmd->add_flag("!--no-size-check", args->read.check_image_sizes,
-                "Do not compare image headers with the camera sizes");
-  cmd->add_option("--ground-height", args->ground_height,
-                  "Mean ground height (block units) for blocks that carry no surface estimate");
+  AddBlockFlags(cmd, &args->flags);
   cmd->callback([args] {
-    args->read.format = ParseBlockFormat(args->format);
-    Block block = ReadBlock(args->block, args->read);
-    if (!std::isnan(args->ground_height)) {
-      if (!std::isfinite(args->ground_height)) throw Error("--ground-height must be finite");
-      block.ground_height = args->ground_height;
-    }
+    const Block block = ReadBlockWithFlags(args->block, args->flags);
     PrintInfo(block, std::cout);
   });
+}
+
+void AddBlockFlags(CLI::App* cmd, BlockFlags* flags) {
+  cmd->add_option("--format", flags->format,
+                  "Block format: auto, yaml, pmvs, colmap, strecha, opensfm")
+      ->capture_default_str();
+  cmd->add_option("--image-dir", flags->read.image_dir,
+                  "Folder holding the images (overrides the block's)");
+  cmd->add_flag("!--no-size-check", flags->read.check_image_sizes,
+                "Do not compare image headers with the camera sizes");
+  cmd->add_option("--ground-height", flags->ground_height,
+                  "Mean ground height (block units) for blocks that carry no surface estimate");
+}
+
+Block ReadBlockWithFlags(const std::string& path, BlockFlags& flags) {
+  flags.read.format = ParseBlockFormat(flags.format);
+  Block block = ReadBlock(path, flags.read);
+  if (!std::isnan(flags.ground_height)) {
+    if (!std::isfinite(flags.ground_height)) throw Error("--ground-height must be finite");
+    block.ground_height = flags.ground_height;
+  }
+  return block;
 }
 
 }  // namespace sapmvs::cli

@@ -1,5 +1,6 @@
-// `sapmvs run BLOCK --out DIR`: dense matching of a block small enough for one
-// group. Flags map one to one onto RunOptions / MatcherOptions.
+// `sapmvs run BLOCK --out DIR`: a whole block, grouped, matched, merged.
+// Flags map one to one onto RunOptions / MatcherOptions / GroupingOptions /
+// DsmOptions.
 #include <CLI/CLI.hpp>
 
 #include <iostream>
@@ -14,8 +15,11 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   auto o = std::make_shared<RunOptions>();
   auto mode = std::make_shared<std::string>("sapmvs");
   auto no_edges = std::make_shared<bool>(false);
+  auto strategy = std::make_shared<std::string>("strip");
+  auto budget = std::make_shared<std::string>("8G");
   MatcherOptions& m = o->matcher;
-  CLI::App* cmd = app.add_subcommand("run", "Dense matching of a block: cloud.ply and report.json");
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json");
   cmd->add_option("block", o->block,
                   "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
       ->required();
@@ -67,7 +71,27 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--min-cluster", m.min_cluster_size, "Filter: smallest cluster kept, points")
       ->capture_default_str();
-  cmd->callback([o, mode, no_edges, &global] {
+  cmd->add_option("--strategy", *strategy, "Grouping: strip (the paper) or footprint")
+      ->capture_default_str();
+  cmd->add_option("--max-images", o->grouping.max_images, "Most images per group")
+      ->capture_default_str();
+  cmd->add_option("--memory-budget", *budget, "Memory one group may use (8G, 512M, ...)")
+      ->capture_default_str();
+  cmd->add_flag("--restart", o->restart, "Discard the checkpoints in DIR/groups and start over");
+  cmd->add_option("--max-groups", o->max_groups,
+                  "Match at most this many groups now, then stop (resumable; 0 = all)")
+      ->capture_default_str();
+  cmd->add_option("--merge-radius", o->merge_radius_gsd,
+                  "Merge: duplicate distance, GSDs of the level matched")
+      ->capture_default_str();
+  cmd->add_option("--dsm-cell", o->dsm.cell_size,
+                  "DSM cell, CRS units (0 = twice the mean point spacing)")
+      ->capture_default_str();
+  cmd->add_option("--dsm-fill", o->dsm.fill_passes, "DSM gap-filling passes")
+      ->capture_default_str();
+  cmd->callback([o, mode, no_edges, strategy, budget, &global] {
+    o->grouping.strategy = ParseGroupingStrategy(*strategy);
+    o->grouping.memory_budget = ParseByteSize(*budget);
     o->matcher.mode = ParseMatchMode(*mode);
     o->matcher.use_edges = !*no_edges;
     o->matcher.progress = !global.quiet;

@@ -1,144 +1,318 @@
 #include "sapmvs/dense_run.h"
 
+#include <sys/resource.h>
+
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <numeric>
+#include <sstream>
 
 #include "cl_runtime.h"
-#include "sapmvs/atomic_file.h"
+#include "run_checkpoint.h"
+#include "run_report.h"
+#include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
+#include "sapmvs/las_io.h"
 #include "sapmvs/ply_io.h"
+#include "sapmvs/progress.h"
+#include "sapmvs/raster_io.h"
 
 namespace sapmvs {
 
+std::string RunOptions::Problem() const {
+  if (block.empty()) return "a block path";
+  if (out.empty()) return "an output folder (--out)";
+  std::string p = matcher.Problem();
+  if (!p.empty()) return p;
+  GroupingOptions g = grouping;
+  g.level = matcher.level;
+  p = g.Problem();
+  if (!p.empty()) return p;
+  if (max_groups < 0) return "max_groups >= 0 (max_groups = " + std::to_string(max_groups) + ")";
+  if (!(std::isfinite(merge_radius_gsd) && merge_radius_gsd > 0)) {
+    std::ostringstream s;
+    s << "a merge radius > 0 GSD (merge_radius_gsd = " << merge_radius_gsd << ")";
+    return s.str();
+  }
+  return dsm.Problem();
+}
+
 bool RunOptions::Check() const {
-  if (block.empty()) {
-    std::cerr << "RunOptions: expected a block path\n";
-    return false;
-  }
-  if (out.empty()) {
-    std::cerr << "RunOptions: expected an output folder\n";
-    return false;
-  }
-  return matcher.Check();
+  const std::string p = Problem();
+  if (!p.empty()) std::cerr << "RunOptions: expected " << p << "\n";
+  return p.empty();
+}
+
+std::string FormatHms(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  return buf;
 }
 
 namespace {
 
-nlohmann::json ReportJson(const RunOptions& options, const RunReport& report, const Block& block) {
-  const MatchStats& s = report.stats;
-  nlohmann::json j;
-  j["block"] = options.block.string();
-  j["mode"] = ToString(options.matcher.mode);
-  j["level"] = options.matcher.level;
-  j["device"] = report.device;
-  j["images"] = s.images;
-  j["points"] = s.points;
-  j["gsd_at_level"] = s.gsd;
-  j["crs"] = block.crs;
-  j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
-  j["total_seconds"] = report.total_seconds;
-  j["features"] = s.features;
-  j["seeds"] = {{"tried", s.seeds_tried}, {"accepted", s.seeds_accepted}};
-  j["edges"] = {{"edge_pixels", s.edge_points}, {"matched", s.matched_edge_points}};
-  j["propagation"] = {{"waves", s.waves},
-                      {"candidates", s.candidates},
-                      {"largest_wave", s.largest_wave},
-                      {"patches", s.patches}};
-  nlohmann::json sizes = nlohmann::json::object();
-  for (const auto& [size, count] : s.accepted_by_size) sizes[std::to_string(size)] = count;
-  j["propagation"]["accepted_by_size"] = sizes;
-  j["filter"] = {{"points_before", s.points_before_filter},
-                 {"removed_visibility", s.removed_visibility},
-                 {"removed_neighbourhood", s.removed_neighbourhood},
-                 {"removed_clusters", s.removed_clusters}};
-  nlohmann::json stages = nlohmann::json::array();
+double Since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+double PeakRssBytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return 1024.0 * static_cast<double>(u.ru_maxrss);  // Linux reports kilobytes
+}
+
+void AddStats(const MatchStats& s, MatchStats* sum) {
+  sum->images += s.images;
+  sum->features += s.features;
+  sum->seeds_tried += s.seeds_tried;
+  sum->seeds_accepted += s.seeds_accepted;
+  sum->edge_points += s.edge_points;
+  sum->matched_edge_points += s.matched_edge_points;
+  sum->candidates += s.candidates;
+  sum->patches += s.patches;
+  sum->waves += s.waves;
+  sum->largest_wave = std::max(sum->largest_wave, s.largest_wave);
+  for (const auto& [size, n] : s.accepted_by_size) sum->accepted_by_size[size] += n;
+  sum->points_before_filter += s.points_before_filter;
+  sum->removed_visibility += s.removed_visibility;
+  sum->removed_neighbourhood += s.removed_neighbourhood;
+  sum->removed_clusters += s.removed_clusters;
+  sum->points += s.points;
   for (const auto& [name, t] : s.stages) {
-    stages.push_back({{"stage", name}, {"wall_seconds", t.wall}, {"device_seconds", t.device}});
+    auto it = std::find_if(sum->stages.begin(), sum->stages.end(),
+                           [&](const auto& e) { return e.first == name; });
+    if (it == sum->stages.end()) {
+      sum->stages.emplace_back(name, t);
+    } else {
+      it->second.wall += t.wall;
+      it->second.device += t.device;
+    }
   }
-  j["stages"] = stages;
-  nlohmann::json kernels = nlohmann::json::array();
-  for (const auto& [name, t] : s.kernels) {
-    kernels.push_back({{"kernel", name},
-                       {"launches", t.launches},
-                       {"items", t.items},
-                       {"device_seconds", t.seconds}});
+  for (const auto& [name, k] : s.kernels) {
+    KernelTime& d = sum->kernels[name];
+    d.launches += k.launches;
+    d.items += k.items;
+    d.seconds += k.seconds;
   }
-  j["kernels"] = kernels;
-  return j;
+  sum->gsd = s.gsd;
+}
+
+std::vector<PointRecord> ToLasRecords(const PointCloud& cloud) {
+  std::vector<PointRecord> out(cloud.points.size());
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    const CloudPoint& p = cloud.points[i];
+    PointRecord& r = out[i];
+    r.x = p.position.x();
+    r.y = p.position.y();
+    r.z = p.position.z();
+    r.r = ColorTo16(p.color[0]);
+    r.g = ColorTo16(p.color[1]);
+    r.b = ColorTo16(p.color[2]);
+    r.classification = 1;  // unclassified
+  }
+  return out;
 }
 
 }  // namespace
 
 RunReport RunDense(const RunOptions& options) {
-  if (options.block.empty()) throw Error("run: expected a block path");
-  if (options.out.empty()) throw Error("run: expected an output folder (--out)");
-  const std::string problem = options.matcher.Problem();
+  const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("run: expected " + problem);
   const auto start = std::chrono::steady_clock::now();
+  RunReport report;
+  report.out = options.out;
+  auto stage_start = start;
+  auto end_stage = [&](const std::string& name) {
+    report.stages.emplace_back(name, Since(stage_start));
+    stage_start = std::chrono::steady_clock::now();
+  };
+
   const Block block = ReadBlock(options.block);
+  report.images = static_cast<int>(block.images.size());
+  GroupingOptions gopt = options.grouping;
+  gopt.level = options.matcher.level;
+  GroupingPlan plan;
+  std::vector<int> every(block.images.size());
+  std::iota(every.begin(), every.end(), 0);
+  if (static_cast<int>(block.images.size()) <= gopt.max_images &&
+      EstimateGroupMemory(block, every, options.matcher).Total() <= gopt.memory_budget) {
+    // Small enough for one group: splitting would only lose views.
+    ImageGroup all;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (size_t i = 0; i < block.images.size(); ++i) {
+      all.images.push_back(static_cast<int>(i));
+      sum += block.images[i].camera.center().head<2>() - block.origin.head<2>();
+    }
+    all.center = sum / std::max<size_t>(1, block.images.size());
+    all.memory = EstimateGroupMemory(block, all.images, options.matcher);
+    plan.strategy = gopt.strategy;
+    plan.groups.push_back(all);
+    report.strategy = "single group";
+  } else {
+    plan = PlanGroups(block, gopt);
+    report.strategy = ToString(plan.strategy);
+  }
+  end_stage("plan");
+
+  std::error_code ec;
+  std::filesystem::create_directories(options.out, ec);
+  if (ec) throw Error(options.out.string() + ": cannot create the output folder: " + ec.message());
+  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher, options.restart);
+
   DeviceOptions device_options;
   device_options.device = options.device;
   device_options.profile = true;
   ClContext context(device_options);
-  std::error_code ec;
-  std::filesystem::create_directories(options.out, ec);
-  if (ec) throw Error(options.out.string() + ": cannot create the output folder: " + ec.message());
-
-  MatchResult result = MatchGroup(block, {}, options.matcher, context);
-  RunReport report;
-  report.stats = std::move(result.stats);
   report.device = context.device().Describe();
-  report.cloud_path = options.out / "cloud.ply";
-  report.report_path = options.out / "report.json";
-  if (result.cloud.points.empty()) {
+
+  const bool show = options.matcher.progress && Progress::TerminalAllowsProgress();
+  const int n = static_cast<int>(plan.groups.size());
+  int matched_now = 0;
+  for (int g = 0; g < n; ++g) {
+    GroupRun run;
+    run.index = g;
+    for (const int i : plan.groups[g].images) run.images.push_back(block.images[i].name);
+    if (checkpoints.Done(g)) {
+      const GroupCheckpoint c = checkpoints.Read(g);
+      run.points = c.points;
+      run.seconds = c.seconds;
+      run.resumed = true;
+      report.groups.push_back(run);
+      continue;
+    }
+    if (options.max_groups > 0 && matched_now >= options.max_groups) {
+      report.groups.push_back(run);
+      continue;
+    }
+    if (show) {
+      std::fprintf(stderr, "group %d/%d: %zu images\n", g + 1, n, plan.groups[g].images.size());
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    MatchResult result = MatchGroup(block, plan.groups[g].images, options.matcher, context);
+    run.seconds = Since(t0);
+    run.points = static_cast<long>(result.cloud.points.size());
+    AddStats(result.stats, &report.stats);
+    checkpoints.Write(g, result.cloud, run.seconds, result.stats);
+    ++matched_now;
+    report.groups.push_back(run);
+  }
+  end_stage("match");
+  for (int g = 0; g < n; ++g) {
+    if (checkpoints.Done(g)) continue;
+    report.total_seconds = Since(start);
+    report.peak_rss_bytes = PeakRssBytes();
+    return report;  // stopped by max_groups: resumable
+  }
+
+  // Merge from the checkpoints, fresh or resumed alike.
+  std::vector<PointCloud> clouds(n);
+  std::vector<GroupCloud> parts(n);
+  for (int g = 0; g < n; ++g) {
+    clouds[g] = ReadPly(checkpoints.CloudPath(g));
+    parts[g].cloud = &clouds[g];
+    parts[g].center = plan.groups[g].center + block.origin.head<2>();
+  }
+  MergeOptions mo;
+  mo.radius = options.merge_radius_gsd * EstimateBlockGeometry(block).gsd_median *
+              std::ldexp(1.0, options.matcher.level);
+  PointCloud merged = MergeGroupClouds(parts, mo, &report.merge);
+  if (merged.crs.empty()) merged.crs = block.crs;
+  clouds.clear();
+  end_stage("merge");
+  if (merged.points.empty()) {
     throw Error(options.block.string() +
                 ": no point survived matching and filtering; nothing "
                 "written (check the orientation, or lower --threshold)");
   }
-  WritePly(report.cloud_path, result.cloud);
-  report.total_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const nlohmann::json j = ReportJson(options, report, block);
-  WriteFileAtomically(report.report_path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp);
-    f << std::setw(2) << j << "\n";
-    if (!f) throw Error(report.report_path.string() + ": write failed");
-  });
+  report.points = static_cast<long>(merged.points.size());
+  report.mean_spacing = MeanPointSpacing(merged);
+  const GeoRaster dsm = RasterizeDsm(merged, options.dsm, &report.dsm_cell);
+  const CloudFootprint fp = MeasureFootprint(merged, report.dsm_cell);
+  report.area = fp.area;
+  report.density = fp.density;
+  end_stage("statistics");
+
+  WritePly(options.out / "cloud.ply", merged);
+  LasWriteOptions lo;
+  lo.crs = block.crs;
+  WriteLas(options.out / "cloud.las", ToLasRecords(merged), lo);
+  WriteGeoTiff(options.out / "dsm.tif", dsm);
+  WriteReliefPng(options.out / "dsm.png", dsm);
+  end_stage("write");
+  report.finished = true;
+  report.total_seconds = Since(start);
+  report.peak_rss_bytes = PeakRssBytes();
+  WriteRunReport(options, report, block, plan);
   return report;
 }
 
 void PrintRunSummary(const RunReport& report, std::ostream& out) {
   const MatchStats& s = report.stats;
   out << "device        " << report.device << "\n";
-  out << "images        " << s.images << "\n";
-  out << "seeds         " << s.seeds_accepted << " of " << s.seeds_tried << " tried\n";
-  out << "propagation   " << s.waves << " waves, " << s.candidates << " candidates, " << s.patches
-      << " patches";
-  if (!s.accepted_by_size.empty()) {
-    out << " (";
-    bool first = true;
-    for (auto it = s.accepted_by_size.rbegin(); it != s.accepted_by_size.rend(); ++it) {
-      out << (first ? "" : ", ") << it->first << "x" << it->first << ": " << it->second;
-      first = false;
+  out << "groups        " << report.groups.size() << " (" << report.strategy << ")\n";
+  for (const GroupRun& g : report.groups) {
+    out << "  group " << std::setw(3) << g.index + 1 << "  " << std::setw(2) << g.images.size()
+        << " images  ";
+    if (g.resumed) {
+      out << std::setw(9) << g.points << " points  (checkpoint)";
+    } else if (g.seconds > 0 || g.points > 0) {
+      out << std::setw(9) << g.points << " points  " << FormatHms(g.seconds);
+    } else {
+      out << "          not run yet";
     }
-    out << ")";
+    out << "\n";
   }
-  out << "\n";
-  out << "filter        " << s.points_before_filter << " -> " << s.points << " points\n";
+  if (s.waves > 0) {
+    out << "propagation   " << s.waves << " waves, " << s.candidates << " candidates, " << s.patches
+        << " patches";
+    if (!s.accepted_by_size.empty()) {
+      out << " (";
+      bool first = true;
+      for (auto it = s.accepted_by_size.rbegin(); it != s.accepted_by_size.rend(); ++it) {
+        out << (first ? "" : ", ") << it->first << "x" << it->first << ": " << it->second;
+        first = false;
+      }
+      out << ")";
+    }
+    out << "\n";
+  }
   out << std::fixed << std::setprecision(2);
   for (const auto& [name, t] : s.stages) {
     out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t.wall
-        << " s wall" << (t.device > 0 ? ", " : "");
-    if (t.device > 0) out << t.device << " s in kernels";
+        << " s wall";
+    if (t.device > 0) out << ", " << t.device << " s in kernels";
     out << "\n";
   }
-  out << "total         " << report.total_seconds << " s\n";
-  out << "cloud         " << report.cloud_path.string() << "\n";
-  out << "report        " << report.report_path.string() << "\n";
+  for (const auto& [name, t] : report.stages) {
+    if (name == "match") continue;
+    out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t
+        << " s wall\n";
+  }
+  if (!report.finished) {
+    out << "stopped       after the groups asked for; run again to resume\n";
+    out.unsetf(std::ios::floatfield);
+    return;
+  }
+  out << "merge         " << report.merge.input << " -> " << report.points << " points ("
+      << report.merge.duplicates << " cross-group duplicates dropped)\n";
+  out << "\n";
+  out << "images  points      run time  avg. distance  density (pts/unit^2)\n";
+  out << std::left << std::setw(8) << report.images << std::setw(12) << report.points
+      << std::setw(10) << FormatHms(report.total_seconds) << std::right << std::setprecision(3)
+      << std::setw(15) << report.mean_spacing << std::setw(22) << report.density << "\n\n";
+  out << std::setprecision(2);
+  out << "total         " << report.total_seconds << " s, peak memory "
+      << report.peak_rss_bytes / (1 << 20) << " MiB\n";
+  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm.png", "report.json"}) {
+    out << "wrote         " << (report.out / f).string() << "\n";
+  }
   out.unsetf(std::ios::floatfield);
 }
 

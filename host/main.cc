@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   sapmvs::cli::RegisterInfoCommand(app, global);
   sapmvs::cli::RegisterSimulateCommand(app, global);
   sapmvs::cli::RegisterRunCommand(app, global);
+  sapmvs::cli::RegisterPlanCommand(app, global);
   sapmvs::cli::RegisterEvaluateCommand(app, global);
 
   try {

@@ -52,6 +52,7 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
   std::vector<uint8_t> covered(static_cast<size_t>(cols) * rows, 0);
   std::vector<double> abs_dz;
   for (const CloudPoint& p : cloud.points) {
+    if (options.region && !options.region(p.position.x(), p.position.y())) continue;
     const double h = CellHeight(surface, p.position.x(), p.position.y());
     if (!std::isfinite(h)) continue;
     ++out.checked;
@@ -80,6 +81,7 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
     for (int c = 0; c < cols; ++c) {
       const double x = x0 + (c + 0.5) * options.cell_size;
       const double y = y0 - (r + 0.5) * options.cell_size;
+      if (options.region && !options.region(x, y)) continue;
       const double h = CellHeight(surface, x, y);
       if (!std::isfinite(h)) continue;
       const Eigen::Vector3d p(x, y, h);

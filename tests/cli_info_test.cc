@@ -91,9 +91,7 @@ TEST(Cli, HelpListsOnlyWorkingSubcommands) {
   EXPECT_NE(r.out.find("simulate"), std::string::npos);
   EXPECT_NE(r.out.find("evaluate"), std::string::npos);
   EXPECT_NE(r.out.find("run"), std::string::npos);
-  for (const char* later : {"plan"}) {
-    EXPECT_EQ(r.out.find(std::string("  ") + later + " "), std::string::npos) << later;
-  }
+  EXPECT_NE(r.out.find("  plan "), std::string::npos) << r.out;
 }
 
 }  // namespace

@@ -1,10 +1,16 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 #include <string>
+#include <tuple>
 
 #include "cl_runtime.h"
 #include "cli_test_util.h"
@@ -103,10 +109,20 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
   }
   EXPECT_TRUE(launched) << j.at("kernels");
 
-  // Nothing but the two outputs: no temporary file left behind.
-  int files = 0;
-  for (const auto& e : fs::recursive_directory_iterator(out_)) files += e.is_regular_file();
-  EXPECT_EQ(files, 2);
+  // The outputs and one group's checkpoint, no temporary file left behind.
+  std::set<std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(out_)) {
+    if (e.is_regular_file()) files.insert(fs::relative(e.path(), out_).string());
+  }
+  const std::set<std::string> expected = {"cloud.ply",
+                                          "cloud.las",
+                                          "dsm.tif",
+                                          "dsm.png",
+                                          "report.json",
+                                          "groups/plan.json",
+                                          "groups/group_001.ply",
+                                          "groups/group_001.json"};
+  EXPECT_EQ(files, expected);
 }
 
 TEST_F(CliRunTest, MinImageNumTwoIsAccepted) {
@@ -153,6 +169,194 @@ TEST_F(CliRunTest, NegativeLevelIsOneLineNamingIt) {
   EXPECT_NE(r.err.find("level"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("-1"), std::string::npos) << r.err;
   EXPECT_TRUE(NoOutput());
+}
+
+// Whole-block runs: the tiny block (2 strips of 2 images) split into one
+// group per strip by --max-images 3, matched with min_image_num 2.
+class CliBlockRunTest : public CliRunTest {
+ protected:
+  static std::string Args(const fs::path& out, const std::string& more = "") {
+    return "run " + Block().string() + " --out " + out.string() +
+           " --min-image-num 2 --max-images 3 -q " + more;
+  }
+  static std::string Bytes(const fs::path& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::ostringstream s;
+    s << f.rdbuf();
+    return s.str();
+  }
+  static nlohmann::json Report(const fs::path& out) {
+    std::ifstream in(out / "report.json");
+    return nlohmann::json::parse(in);
+  }
+};
+
+TEST_F(CliBlockRunTest, ResumedRunWritesTheSameCloud) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const fs::path whole = out_ / "whole", parts = out_ / "parts";
+  const auto a = RunCli(Args(whole));
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const nlohmann::json ja = Report(whole);
+  ASSERT_EQ(ja.at("groups").size(), 2u) << ja.at("groups");
+
+  // Stopped after one group: its checkpoint only, no final output.
+  const auto b1 = RunCli(Args(parts, "--max-groups 1"));
+  ASSERT_EQ(b1.exit_code, 0) << b1.err;
+  EXPECT_NE(b1.out.find("resume"), std::string::npos) << b1.out;
+  EXPECT_TRUE(fs::exists(parts / "groups" / "group_001.json"));
+  EXPECT_FALSE(fs::exists(parts / "groups" / "group_002.json"));
+  EXPECT_FALSE(fs::exists(parts / "cloud.ply"));
+  // Resumed: the first group comes from its checkpoint, and the final cloud
+  // is the uninterrupted run's, byte for byte.
+  const auto b2 = RunCli(Args(parts));
+  ASSERT_EQ(b2.exit_code, 0) << b2.err;
+  const nlohmann::json jb = Report(parts);
+  EXPECT_TRUE(jb.at("groups")[0].at("from_checkpoint").get<bool>());
+  EXPECT_FALSE(jb.at("groups")[1].at("from_checkpoint").get<bool>());
+  const std::string cloud_a = Bytes(whole / "cloud.ply");
+  ASSERT_FALSE(cloud_a.empty());
+  EXPECT_TRUE(cloud_a == Bytes(parts / "cloud.ply")) << "resumed cloud differs";
+  EXPECT_EQ(ja.at("points"), jb.at("points"));
+
+  // A run with other options does not mix its groups with these.
+  const auto c = RunCli(Args(parts, "--threshold 0.8"));
+  EXPECT_EQ(c.exit_code, 1);
+  EXPECT_EQ(test::CountLines(c.err), 1) << c.err;
+  EXPECT_NE(c.err.find("plan.json"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("--restart"), std::string::npos) << c.err;
+  const auto d = RunCli(Args(parts, "--threshold 0.8 --restart"));
+  EXPECT_EQ(d.exit_code, 0) << d.err;
+  EXPECT_FALSE(Report(parts).at("groups")[0].at("from_checkpoint").get<bool>());
+}
+
+TEST_F(CliBlockRunTest, MergedCloudHasNoCrossGroupDuplicates) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto r = RunCli(Args(out_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = Report(out_);
+  const PointCloud cloud = ReadPly(out_ / "cloud.ply");
+  // The merged file lists each group's kept points in group order.
+  std::vector<int> group_of;
+  long input = 0;
+  for (size_t g = 0; g < j.at("groups").size(); ++g) {
+    group_of.insert(group_of.end(), j.at("groups")[g].at("kept_after_merge").get<long>(),
+                    static_cast<int>(g));
+    input += j.at("groups")[g].at("points").get<long>();
+  }
+  ASSERT_EQ(group_of.size(), cloud.points.size());
+  EXPECT_EQ(j.at("merge").at("input").get<long>(), input);
+  // Both groups contribute, and the overlap had duplicates to drop.
+  EXPECT_GT(j.at("groups")[0].at("kept_after_merge").get<long>(), 0);
+  EXPECT_GT(j.at("groups")[1].at("kept_after_merge").get<long>(), 0);
+  EXPECT_GT(j.at("merge").at("cross_group_duplicates").get<long>(), 0);
+  // No two points of different groups within 0.25 GSD (the tiny block's GSD
+  // is 0.2727 m at full resolution).
+  const double r25 = 0.25 * 0.2727;
+  std::map<std::tuple<long, long, long>, std::vector<size_t>> grid;
+  auto key = [&](const Eigen::Vector3d& p) {
+    return std::make_tuple(static_cast<long>(std::floor(p.x() / r25)),
+                           static_cast<long>(std::floor(p.y() / r25)),
+                           static_cast<long>(std::floor(p.z() / r25)));
+  };
+  for (size_t i = 0; i < cloud.points.size(); ++i) grid[key(cloud.points[i].position)].push_back(i);
+  long pairs = 0;
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    const auto [x, y, z] = key(cloud.points[i].position);
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy)
+        for (long dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find({x + dx, y + dy, z + dz});
+          if (it == grid.end()) continue;
+          for (const size_t k : it->second) {
+            pairs += group_of[k] != group_of[i] &&
+                     (cloud.points[k].position - cloud.points[i].position).norm() <= r25;
+          }
+        }
+  }
+  EXPECT_EQ(pairs, 0);
+  // The paper's statistics are in the report.
+  EXPECT_GT(j.at("mean_point_spacing").get<double>(), 0);
+  EXPECT_GT(j.at("density_per_unit2").get<double>(), 0);
+  EXPECT_EQ(j.at("grouping"), "strip");
+  EXPECT_NE(r.out.find("avg. distance"), std::string::npos) << r.out;
+}
+
+// Finds copc.js where scripts/install-deps.sh puts it; "" when absent.
+std::string NpmDirWithCopc() {
+  std::stringstream dirs(SAPMVS_NPM_DIRS);
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (fs::exists(fs::path(dir) / "node_modules" / "copc" / "package.json")) return dir;
+  }
+  return "";
+}
+
+TEST_F(CliBlockRunTest, LasIsReadByAnIndependentReader) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const std::string npm = NpmDirWithCopc();
+  if (npm.empty() || std::system("node --version >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "node or copc.js missing (scripts/install-deps.sh installs them into "
+                    "build/npm when the npm registry is reachable)";
+  }
+  const auto r = RunCli(Args(out_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const PointCloud cloud = ReadPly(out_ / "cloud.ply");
+  const fs::path json = out_ / "copc.json";
+  const std::string cmd = "node " + (fs::path(SAPMVS_TEST_DIR) / "las_check.cjs").string() + " " +
+                          npm + " " + (out_ / "cloud.las").string() + " 7 > " + json.string();
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("version"), "1.4");
+  ASSERT_EQ(j.at("count").get<size_t>(), cloud.points.size());
+  // Every 7th point, to the millimetre (the LAS scale is 0.001).
+  ASSERT_GT(j.at("points").size(), 100u);
+  for (const auto& p : j.at("points")) {
+    const CloudPoint& q = cloud.points[p[0].get<size_t>()];
+    ASSERT_NEAR(p[1].get<double>(), q.position.x(), 0.0005 + 1e-9) << p;
+    ASSERT_NEAR(p[2].get<double>(), q.position.y(), 0.0005 + 1e-9) << p;
+    ASSERT_NEAR(p[3].get<double>(), q.position.z(), 0.0005 + 1e-9) << p;
+  }
+}
+
+TEST_F(CliBlockRunTest, DsmIsReadByGdalinfoWithTheBlocksCrsAndTheCloudsExtent) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  if (std::system("gdalinfo --version >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "gdalinfo missing (Debian package gdal-bin)";
+  }
+  const auto r = RunCli(Args(out_));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path json = out_ / "gdalinfo.json";
+  const std::string cmd =
+      "gdalinfo -json " + (out_ / "dsm.tif").string() + " > " + json.string() + " 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("driverShortName"), "GTiff");
+  const std::string wkt = j.at("coordinateSystem").at("wkt").get<std::string>();
+  EXPECT_NE(wkt.find("32632"), std::string::npos) << wkt;  // the tiny block's UTM 32N
+  const PointCloud cloud = ReadPly(out_ / "cloud.ply");
+  double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
+  for (const CloudPoint& p : cloud.points) {
+    xmin = std::min(xmin, p.position.x());
+    xmax = std::max(xmax, p.position.x());
+    ymin = std::min(ymin, p.position.y());
+    ymax = std::max(ymax, p.position.y());
+  }
+  const auto& corners = j.at("cornerCoordinates");
+  const double ulx = corners.at("upperLeft")[0], uly = corners.at("upperLeft")[1];
+  const double lrx = corners.at("lowerRight")[0], lry = corners.at("lowerRight")[1];
+  const double cell = j.at("geoTransform")[1];
+  EXPECT_LE(ulx, xmin);
+  EXPECT_GT(ulx, xmin - cell);
+  EXPECT_GE(uly, ymax);
+  EXPECT_LT(uly, ymax + cell);
+  EXPECT_GE(lrx, xmax);
+  EXPECT_LT(lrx, xmax + cell + 1e-9);
+  EXPECT_LE(lry, ymin);
+  EXPECT_GT(lry, ymin - cell - 1e-9);
+  // The cell defaults to twice the mean point spacing, as the report says.
+  EXPECT_NEAR(cell, Report(out_).at("dsm_cell").get<double>(), 1e-9);
 }
 
 }  // namespace

@@ -106,6 +106,29 @@ TEST(CheckAgainstSurface, HalfThePointsTwoTolerancesUpHalveShareAndCoverage) {
   EXPECT_EQ(s.coverage, 0.5);
 }
 
+TEST(CheckAgainstSurface, ARegionCountsOnlyItsPointsAndCells) {
+  // The left half (x < 1050) is off the surface, the right half on it: each
+  // region sees only its own half.
+  PointCloud cloud = PointPerCell();
+  for (CloudPoint& p : cloud.points) {
+    if (p.position.x() < 1050) p.position.z() += 2 * kTolerance;
+  }
+  SurfaceCheckOptions o = Options();
+  o.region = [](double x, double) { return x < 1050; };
+  const SurfaceCheck left = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), o);
+  o.region = [](double x, double) { return x >= 1050; };
+  const SurfaceCheck right = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), o);
+  const long half = kCheckCells * kCheckCells / 2;
+  EXPECT_EQ(left.checked, half);
+  EXPECT_EQ(left.within, 0);
+  EXPECT_EQ(left.cells_seen, half);
+  EXPECT_EQ(left.cells_covered, 0);
+  EXPECT_EQ(right.checked, half);
+  EXPECT_EQ(right.within, half);
+  EXPECT_EQ(right.cells_seen, half);
+  EXPECT_EQ(right.coverage, 1.0);
+}
+
 TEST(CheckAgainstSurface, PointsJustInsideTheToleranceCount) {
   PointCloud cloud = PointPerCell();
   for (size_t i = 0; i < cloud.points.size(); ++i) {

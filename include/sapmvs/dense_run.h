@@ -1,11 +1,24 @@
 #pragma once
-// `sapmvs run`: one block matched as one group, written as DIR/cloud.ply
-// (binary, world coordinates in double, CRS in the header) and
-// DIR/report.json (points, per-stage wall and device times, kernel times).
+// `sapmvs run`: a whole block. The images are planned into groups
+// (grouping.h; one group when the block has at most max_images images), each
+// group is matched (matcher.h) and checkpointed to DIR/groups/, and the group
+// clouds are merged (cloud_merge.h) into
+//   DIR/cloud.ply    binary, world coordinates in double, CRS in the header
+//   DIR/cloud.las    LAS 1.4 with RGB and the block's CRS
+//   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h), DIR/dsm.png its colour relief
+//   DIR/report.json  points, groups, per-stage wall and device times, kernel
+//                    times, the paper's statistics (Tables 4, 6, 8)
+// A killed run resumes from its last finished group; the merge always reads
+// the checkpoints back, so a resumed run writes the same cloud as one that
+// was never interrupted.
 #include <filesystem>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
+#include "sapmvs/cloud_dsm.h"
+#include "sapmvs/cloud_merge.h"
+#include "sapmvs/grouping.h"
 #include "sapmvs/matcher.h"
 
 namespace sapmvs {
@@ -16,22 +29,58 @@ struct RunOptions {
   // OpenCL device: index or name substring ("" = SAPMVS_DEVICE, else the default).
   std::string device;
   MatcherOptions matcher;
+  // Its level is taken from matcher.level.
+  GroupingOptions grouping;
+  // Discard DIR/groups/ and start over instead of resuming.
+  bool restart = false;
+  // Match at most this many groups in this call, then stop (resumable);
+  // 0 = all. For splitting a long run into sessions.
+  int max_groups = 0;
+  // Merge: a point is a duplicate of another group's point within this many
+  // ground sample distances of the matched level. > 0.
+  double merge_radius_gsd = 1.0;
+  DsmOptions dsm;
+
+  // Empty when usable, else what was expected, naming the value.
+  std::string Problem() const;
   bool Check() const;
 };
 
+struct GroupRun {
+  int index = 0;  // 0-based
+  std::vector<std::string> images;
+  long points = 0;
+  double seconds = 0;
+  bool resumed = false;  // read from a checkpoint of an earlier call
+};
+
 struct RunReport {
-  std::filesystem::path cloud_path;
-  std::filesystem::path report_path;
+  std::filesystem::path out;
   std::string device;
+  std::string strategy;
+  bool finished = false;  // false: stopped by max_groups, outputs not written
+  int images = 0;
+  std::vector<GroupRun> groups;
+  MatchStats stats;  // summed over the groups matched in this call
+  MergeStats merge;
+  long points = 0;
+  double mean_spacing = 0;  // mean nearest-neighbour distance, CRS units
+  double density = 0;       // points per CRS unit squared of covered ground
+  double area = 0;
+  double dsm_cell = 0;
   double total_seconds = 0;
-  MatchStats stats;
+  double peak_rss_bytes = 0;
+  std::vector<std::pair<std::string, double>> stages;  // wall seconds, this call
 };
 
 // Throws Error for bad options or input, NoDeviceError without a device.
 // Outputs are written atomically: a failed run leaves no partial file.
 RunReport RunDense(const RunOptions& options);
 
-// The summary printed after a run.
+// The summary printed after a run, in the form of the paper's Tables 4/6/8.
 void PrintRunSummary(const RunReport& report, std::ostream& out);
+
+// Seconds as h:min:s, as the paper's tables give run times.
+std::string FormatHms(double seconds);
 
 }  // namespace sapmvs

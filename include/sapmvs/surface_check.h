@@ -8,6 +8,7 @@
 //    when the surface at its centre projects into at least `min_images`
 //    images unoccluded (a ray march through the raster), and "covered" when
 //    it holds a point within `tolerance`.
+#include <functional>
 #include <vector>
 
 #include "sapmvs/block.h"
@@ -20,6 +21,10 @@ struct SurfaceCheckOptions {
   double tolerance = 0;  // block units, > 0 (e.g. one GSD)
   double cell_size = 0;  // block units, > 0 (e.g. the matcher's cell footprint)
   int min_images = 3;
+  // When set, only points and cells (by their centre) at world (x, y) where
+  // it returns true count: to compare zones of one cloud, such as group
+  // borders and group centres. Called concurrently.
+  std::function<bool(double x, double y)> region;
 };
 
 struct SurfaceCheck {

@@ -1,0 +1,532 @@
+#include "sapmvs/grouping.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <tuple>
+
+#include "ncc_scorer.h"
+#include "patch_engine.h"
+#include "patch_refiner.h"
+#include "propagation.h"
+#include "sapmvs/block_geometry.h"
+#include "sapmvs/error.h"
+#include "sapmvs/kernel_limits.h"
+#include "sapmvs/matcher.h"
+#include "strip_detection.h"
+
+namespace sapmvs {
+namespace {
+
+// Samples per tile side for the footprint strategy's coverage counts: 64
+// points tell a tile half in view from one fully in view, at 64 point-in-quad
+// tests per image and tile.
+constexpr int kTileSamples = 8;
+
+// Where each image sees the ground, local frame.
+struct Footprint {
+  bool valid = false;
+  std::array<Eigen::Vector2d, 4> corners;
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();  // of the corners; camera XY when invalid
+  Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = Eigen::Vector2d::Zero();  // bounding box
+  double scene_z = 0;
+  double short_side = 0;
+
+  bool Contains(const Eigen::Vector2d& p) const {
+    if (!valid || (p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return false;
+    // Convex quad: p is inside when it lies on one side of every edge.
+    int pos = 0, neg = 0;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d e = corners[(k + 1) % 4] - corners[k], q = p - corners[k];
+      const double c = e.x() * q.y() - e.y() * q.x();
+      pos += c > 0;
+      neg += c < 0;
+    }
+    return pos == 0 || neg == 0;
+  }
+};
+
+std::vector<Footprint> Footprints(const Block& block, const BlockGeometry& geometry) {
+  std::vector<Footprint> out(block.images.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    Footprint& f = out[i];
+    const ImageGeometry& g = geometry.images[i];
+    f.center = (block.images[i].camera.center() - block.origin).head<2>();
+    if (!g.valid) continue;
+    f.valid = true;
+    f.center.setZero();
+    for (int k = 0; k < 4; ++k) {
+      f.corners[k] = (g.footprint[k] - block.origin).head<2>();
+      f.center += f.corners[k] / 4;
+    }
+    f.lo = f.hi = f.corners[0];
+    for (const Eigen::Vector2d& c : f.corners) {
+      f.lo = f.lo.cwiseMin(c);
+      f.hi = f.hi.cwiseMax(c);
+    }
+    f.scene_z = g.scene_point.z() - block.origin.z();
+    f.short_side =
+        std::min((f.corners[1] - f.corners[0]).norm(), (f.corners[3] - f.corners[0]).norm());
+  }
+  return out;
+}
+
+std::string GroupNames(const Block& block, const std::vector<int>& ids) {
+  std::string s;
+  for (size_t k = 0; k < ids.size() && k < 4; ++k) s += (k ? ", " : "") + block.images[ids[k]].name;
+  return ids.size() > 4 ? s + ", ..." : s;
+}
+
+// Throws when the smallest useful group, the two largest images, does not
+// fit: every other pair then fits too, as the estimate grows with pixels.
+void CheckTwoImagesFit(const Block& block, const GroupingOptions& o) {
+  std::vector<int> ids(block.images.size());
+  std::iota(ids.begin(), ids.end(), 0);
+  std::partial_sort(ids.begin(), ids.begin() + 2, ids.end(), [&](int a, int b) {
+    const Camera &ca = block.images[a].camera, &cb = block.images[b].camera;
+    return static_cast<double>(ca.width()) * ca.height() >
+           static_cast<double>(cb.width()) * cb.height();
+  });
+  ids.resize(2);
+  const GroupMemory m = EstimateGroupMemory(block, ids, o.level);
+  if (m.Total() > o.memory_budget) {
+    throw Error("memory budget " + FormatBytes(o.memory_budget) +
+                " is too small: a group of 2 images (" + GroupNames(block, ids) + ") needs " +
+                FormatBytes(m.Total()) + " at level " + std::to_string(o.level) + " (device " +
+                FormatBytes(m.device_bytes) + " + host " + FormatBytes(m.host_bytes) +
+                "); raise the budget or match at a coarser level");
+  }
+}
+
+bool Fits(const Block& block, const std::vector<int>& ids, const GroupingOptions& o) {
+  return EstimateGroupMemory(block, ids, o.level).Total() <= o.memory_budget;
+}
+
+Eigen::Vector2d MeanCenter(const std::vector<Footprint>& fp, const std::vector<int>& ids) {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const int i : ids) c += fp[i].center;
+  return c / static_cast<double>(ids.size());
+}
+
+// Runs of at most k images; a single image left at the end takes one from
+// the run before it (k >= 3) or shares its last image (k = 2).
+std::vector<std::vector<int>> CutRuns(const std::vector<int>& strip, size_t k) {
+  std::vector<std::vector<int>> runs;
+  for (size_t i = 0; i < strip.size(); i += k)
+    runs.emplace_back(strip.begin() + i, strip.begin() + std::min(i + k, strip.size()));
+  if (runs.size() >= 2 && runs.back().size() == 1) {
+    std::vector<int>& prev = runs[runs.size() - 2];
+    runs.back().insert(runs.back().begin(), prev.back());
+    if (prev.size() >= 3) prev.pop_back();
+  }
+  return runs;
+}
+
+void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<Footprint>& fp,
+                GroupingPlan* plan) {
+  std::vector<int> singles;
+  for (size_t s = 0; s < plan->strips.size(); ++s) {
+    const std::vector<int>& strip = plan->strips[s];
+    if (strip.size() < 2) {
+      singles.push_back(strip[0]);
+      continue;
+    }
+    // One run length per strip keeps the paper's pattern (6+6+4) while the
+    // budget allows, and shortens every run of the strip when it does not.
+    std::vector<std::vector<int>> runs;
+    for (int k = o.max_images; k >= 2; --k) {
+      runs = CutRuns(strip, static_cast<size_t>(k));
+      if (std::all_of(runs.begin(), runs.end(),
+                      [&](const std::vector<int>& r) { return Fits(block, r, o); }))
+        break;
+    }
+    for (std::vector<int>& run : runs) {
+      ImageGroup g;
+      g.images = std::move(run);
+      g.strip = static_cast<int>(s);
+      plan->groups.push_back(std::move(g));
+    }
+  }
+  if (plan->groups.empty()) {
+    // No strip structure (a terrestrial or convergent block): its images in
+    // block order are the one strip.
+    std::vector<int> all(block.images.size());
+    std::iota(all.begin(), all.end(), 0);
+    GroupingPlan whole = *plan;
+    whole.strips = {all};
+    whole.groups.clear();
+    PlanStrips(block, o, fp, &whole);
+    plan->groups = std::move(whole.groups);
+    for (ImageGroup& g : plan->groups) g.strip = -1;
+    return;
+  }
+  for (ImageGroup& g : plan->groups) g.center = MeanCenter(fp, g.images);
+  for (const int i : singles) {
+    std::vector<size_t> order(plan->groups.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return (plan->groups[a].center - fp[i].center).squaredNorm() <
+             (plan->groups[b].center - fp[i].center).squaredNorm();
+    });
+    bool joined = false;
+    for (const size_t gi : order) {
+      ImageGroup& g = plan->groups[gi];
+      std::vector<int> with = g.images;
+      with.push_back(i);
+      if (static_cast<int>(with.size()) > o.max_images || !Fits(block, with, o)) continue;
+      g.images = std::move(with);
+      g.center = MeanCenter(fp, g.images);
+      joined = true;
+      break;
+    }
+    if (!joined) plan->ungrouped.push_back(i);
+  }
+}
+
+void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeometry& geometry,
+                   const std::vector<Footprint>& fp, GroupingPlan* plan) {
+  if (!geometry.aerial) {
+    throw Error("footprint grouping needs a block whose images look down; " +
+                block.source.string() + " is not one (use the strip strategy)");
+  }
+  std::vector<int> valid;
+  std::vector<double> sides;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+  for (size_t i = 0; i < fp.size(); ++i) {
+    if (!fp[i].valid || !geometry.images[i].looks_down) continue;
+    valid.push_back(static_cast<int>(i));
+    sides.push_back(fp[i].short_side);
+    lo = lo.cwiseMin(fp[i].lo);
+    hi = hi.cwiseMax(fp[i].hi);
+  }
+  if (valid.size() < 2) {
+    throw Error("footprint grouping needs the ground footprints of at least 2 images, got " +
+                std::to_string(valid.size()) + " (give the block a ground height or a DEM)");
+  }
+  std::nth_element(sides.begin(), sides.begin() + sides.size() / 2, sides.end());
+  const double side = o.tile_size * sides[sides.size() / 2];
+  const Eigen::Vector2d size = hi - lo;
+  const int nx = std::max(1, static_cast<int>(std::ceil(size.x() / side - 1e-9)));
+  const int ny = std::max(1, static_cast<int>(std::ceil(size.y() / side - 1e-9)));
+  // Tiles split the extent evenly, so the last ones are not slivers.
+  const Eigen::Vector2d tile(size.x() / nx, size.y() / ny);
+  std::vector<bool> used(block.images.size(), false);
+  for (int ty = 0; ty < ny; ++ty) {
+    for (int tx = 0; tx < nx; ++tx) {
+      const Eigen::Vector2d t0 = lo + Eigen::Vector2d(tx * tile.x(), ty * tile.y());
+      const Eigen::Vector2d center = t0 + tile / 2;
+      std::vector<Eigen::Vector2d> samples;
+      for (int sy = 0; sy < kTileSamples; ++sy)
+        for (int sx = 0; sx < kTileSamples; ++sx)
+          samples.push_back(t0 + Eigen::Vector2d((sx + 0.5) * tile.x() / kTileSamples,
+                                                 (sy + 0.5) * tile.y() / kTileSamples));
+      struct Candidate {
+        int image;
+        std::vector<int> seen;  // sample indices
+        double nadir;           // cosine of the ray from the tile centre to the camera
+      };
+      std::vector<Candidate> candidates;
+      std::vector<int> views(samples.size(), 0);
+      for (const int i : valid) {
+        Candidate c{i, {}, 0};
+        for (size_t s = 0; s < samples.size(); ++s)
+          if (fp[i].Contains(samples[s])) c.seen.push_back(static_cast<int>(s));
+        if (c.seen.empty()) continue;
+        for (const int s : c.seen) ++views[s];
+        const Eigen::Vector3d x(center.x(), center.y(), fp[i].scene_z);
+        c.nadir = (block.images[i].camera.center() - block.origin - x).normalized().z();
+        candidates.push_back(std::move(c));
+      }
+      if (*std::max_element(views.begin(), views.end()) < 2) continue;  // nothing to match
+      // Greedy cover: next, the image that brings most samples closer to
+      // tile_views views; ties go to the image that sees more of the tile,
+      // then to the more nadir one.
+      ImageGroup g;
+      const int target = std::min(o.tile_views, o.max_images);
+      std::fill(views.begin(), views.end(), 0);
+      std::vector<bool> taken(candidates.size(), false);
+      while (static_cast<int>(g.images.size()) < o.max_images) {
+        int best = -1;
+        std::tuple<int, size_t, double> best_key{0, 0, 0};
+        for (size_t c = 0; c < candidates.size(); ++c) {
+          if (taken[c]) continue;
+          int gain = 0;
+          for (const int s : candidates[c].seen) gain += views[s] < target;
+          const std::tuple<int, size_t, double> key{gain, candidates[c].seen.size(),
+                                                    candidates[c].nadir};
+          if (gain > 0 && (best < 0 || key > best_key)) {
+            std::vector<int> with = g.images;
+            with.push_back(candidates[c].image);
+            if (!Fits(block, with, o)) continue;
+            best = static_cast<int>(c);
+            best_key = key;
+          }
+        }
+        if (best < 0) break;
+        taken[best] = true;
+        g.images.push_back(candidates[best].image);
+        for (const int s : candidates[best].seen) ++views[s];
+      }
+      if (g.images.size() < 2) continue;
+      for (const int i : g.images) used[i] = true;
+      g.center = center;
+      g.tile_min = t0;
+      g.tile_max = t0 + tile;
+      plan->groups.push_back(std::move(g));
+    }
+  }
+  for (size_t i = 0; i < used.size(); ++i)
+    if (!used[i]) plan->ungrouped.push_back(static_cast<int>(i));
+}
+
+std::string Fixed(double v, int precision) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", precision, v);
+  return buf;
+}
+
+// "IMG_1~IMG_6" for a run of consecutive block images (either way), else
+// every name.
+std::string NamesColumn(const Block& block, const std::vector<int>& ids) {
+  bool run = ids.size() >= 3;
+  for (size_t k = 1; k < ids.size() && run; ++k)
+    run = std::abs(ids[k] - ids[k - 1]) == 1 && (ids[k] - ids[k - 1]) == (ids[1] - ids[0]);
+  if (run) return block.images[ids.front()].name + "~" + block.images[ids.back()].name;
+  std::string s;
+  for (const int i : ids) s += (s.empty() ? "" : " ") + block.images[i].name;
+  return s;
+}
+
+}  // namespace
+
+std::string ToString(GroupingStrategy s) {
+  return s == GroupingStrategy::kStrip ? "strip" : "footprint";
+}
+
+GroupingStrategy ParseGroupingStrategy(const std::string& text) {
+  if (text == "strip") return GroupingStrategy::kStrip;
+  if (text == "footprint") return GroupingStrategy::kFootprint;
+  throw Error("unknown grouping strategy '" + text + "': expected strip or footprint");
+}
+
+std::string GroupingOptions::Problem() const {
+  std::ostringstream s;
+  if (max_images < 2)
+    s << "max_images >= 2 (max_images = " << max_images << ")";
+  else if (!(memory_budget > 0 && std::isfinite(memory_budget)))
+    s << "memory_budget > 0 bytes (memory_budget = " << memory_budget << ")";
+  else if (level < 0 || level > 6)
+    s << "level in 0..6 (level = " << level << ")";
+  else if (!(tile_size > 0 && tile_size <= 4))
+    s << "tile_size in (0, 4] (tile_size = " << tile_size << ")";
+  else if (tile_views < 2)
+    s << "tile_views >= 2 (tile_views = " << tile_views << ")";
+  return s.str();
+}
+
+bool GroupingOptions::Check() const {
+  const std::string problem = Problem();
+  if (!problem.empty()) std::cerr << "GroupingOptions: expected " << problem << "\n";
+  return problem.empty();
+}
+
+GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images, int level) {
+  MatcherOptions matcher;
+  matcher.level = level;
+  return EstimateGroupMemory(block, images, matcher);
+}
+
+GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images,
+                                const MatcherOptions& matcher) {
+  if (matcher.level < 0 || matcher.level > 6)
+    throw Error("memory estimate: level in 0..6 expected, got " + std::to_string(matcher.level));
+  const double views = kMaxViews - 1;
+  const double cs = std::max(1, matcher.cell_size);
+  const double per_cell =
+      4 + 1 + 3 * sizeof(float) + sizeof(AcceptedPatch) + 4 * views + sizeof(DensePoint);
+  GroupMemory m;
+  double load = 0;
+  for (const int id : images) {
+    if (id < 0 || id >= static_cast<int>(block.images.size()))
+      throw Error("memory estimate: image index " + std::to_string(id) + " is outside the block");
+    const Camera& cam = block.images[id].camera;
+    const Intrinsics k = cam.intrinsics().Scaled(std::ldexp(1.0, -matcher.level));
+    const double pixels = static_cast<double>(k.width) * k.height;
+    const double cells = std::ceil(k.width / cs) * std::ceil(k.height / cs);
+    m.device_bytes += 8 * pixels;
+    m.host_bytes += 20 * pixels + per_cell * cells;
+    load = std::max(load, 6.0 * cam.width() * cam.height());
+  }
+  const double wave = std::max(0, matcher.max_wave);
+  m.device_bytes +=
+      wave * (sizeof(NccPatch) + sizeof(RefinedPatchOut) + 4 + views * (sizeof(NccPair) + 4 + 4));
+  m.host_bytes +=
+      wave * (sizeof(PatchCandidate) + sizeof(std::optional<AcceptedPatch>) + 4 * views);
+  m.host_bytes += load;
+  return m;
+}
+
+GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options) {
+  if (const std::string problem = options.Problem(); !problem.empty())
+    throw Error("grouping options: expected " + problem);
+  if (block.images.size() < 2) {
+    throw Error("grouping needs at least 2 images, " + block.source.string() + " has " +
+                std::to_string(block.images.size()));
+  }
+  CheckTwoImagesFit(block, options);
+  GroupingPlan plan;
+  plan.strategy = options.strategy;
+  plan.options = options;
+  plan.strips = DetectStrips(block);
+  const BlockGeometry geometry = EstimateBlockGeometry(block);
+  const std::vector<Footprint> fp = Footprints(block, geometry);
+  if (options.strategy == GroupingStrategy::kStrip)
+    PlanStrips(block, options, fp, &plan);
+  else
+    PlanFootprint(block, options, geometry, fp, &plan);
+  for (ImageGroup& g : plan.groups) g.memory = EstimateGroupMemory(block, g.images, options.level);
+  return plan;
+}
+
+void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) {
+  const GroupingOptions& o = plan.options;
+  out << "block       " << block.source.string() << " (" << block.format << "), "
+      << block.images.size() << " images\n";
+  out << "strips      " << plan.strips.size() << ":";
+  for (const auto& s : plan.strips) out << " " << s.size();
+  out << " images\n";
+  out << "strategy    " << ToString(plan.strategy) << ": at most " << o.max_images
+      << " images per group, level " << o.level << ", memory budget "
+      << FormatBytes(o.memory_budget);
+  if (plan.strategy == GroupingStrategy::kFootprint)
+    out << ", tiles of " << Fixed(o.tile_size, 2) << " footprint, " << o.tile_views << " views";
+  out << "\n";
+  out << "groups      " << plan.groups.size() << "\n";
+
+  std::vector<std::array<std::string, 8>> rows;
+  rows.push_back({"group", "strip", "image numbers", "image names", "images", "centre X, Y",
+                  "device", "host"});
+  double largest = 0;
+  for (size_t g = 0; g < plan.groups.size(); ++g) {
+    const ImageGroup& grp = plan.groups[g];
+    std::string numbers;
+    for (const int i : grp.images) numbers += (numbers.empty() ? "" : " ") + std::to_string(i + 1);
+    rows.push_back({std::to_string(g + 1), grp.strip < 0 ? "-" : std::to_string(grp.strip + 1),
+                    numbers, NamesColumn(block, grp.images), std::to_string(grp.images.size()),
+                    Fixed(grp.center.x(), 1) + ", " + Fixed(grp.center.y(), 1),
+                    FormatBytes(grp.memory.device_bytes), FormatBytes(grp.memory.host_bytes)});
+    largest = std::max(largest, grp.memory.Total());
+  }
+  std::array<size_t, 8> width{};
+  for (const auto& r : rows)
+    for (size_t c = 0; c < r.size(); ++c) width[c] = std::max(width[c], r[c].size());
+  // Numbers right-aligned, text left-aligned; the last column unpadded.
+  const bool right[8] = {true, true, false, false, true, true, true, true};
+  for (const auto& r : rows) {
+    std::string line;
+    for (size_t c = 0; c < r.size(); ++c) {
+      const std::string pad(width[c] - r[c].size(), ' ');
+      line += (c ? "  " : "") + (right[c] ? pad + r[c] : r[c] + (c + 1 < r.size() ? pad : ""));
+    }
+    out << line << "\n";
+  }
+  if (!plan.ungrouped.empty()) {
+    out << "ungrouped  ";
+    for (const int i : plan.ungrouped) out << " " << (i + 1) << " " << block.images[i].name;
+    out << "\n";
+  }
+  out << "largest     " << FormatBytes(largest) << " (device + host) of "
+      << FormatBytes(o.memory_budget) << "; centres in the local frame, origin "
+      << Fixed(block.origin.x(), 3) << " " << Fixed(block.origin.y(), 3) << "\n";
+}
+
+nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
+  using nlohmann::json;
+  const GroupingOptions& o = plan.options;
+  auto names = [&](const std::vector<int>& ids) {
+    json a = json::array();
+    for (const int i : ids) a.push_back(block.images[i].name);
+    return a;
+  };
+  json j;
+  j["block"] = block.source.string();
+  j["format"] = block.format;
+  j["images"] = block.images.size();
+  j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
+  j["strategy"] = ToString(plan.strategy);
+  j["options"] = {{"max_images", o.max_images},
+                  {"memory_budget", o.memory_budget},
+                  {"level", o.level},
+                  {"tile_size", o.tile_size},
+                  {"tile_views", o.tile_views}};
+  j["strips"] = json::array();
+  for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
+  j["groups"] = json::array();
+  for (const ImageGroup& g : plan.groups) {
+    json jg = {
+        {"indices", g.images},
+        {"names", names(g.images)},
+        {"strip", g.strip < 0 ? json(nullptr) : json(g.strip)},
+        {"center", {g.center.x(), g.center.y()}},
+        {"memory", {{"device_bytes", g.memory.device_bytes}, {"host_bytes", g.memory.host_bytes}}}};
+    if (plan.strategy == GroupingStrategy::kFootprint)
+      jg["tile"] = {{"min", {g.tile_min.x(), g.tile_min.y()}},
+                    {"max", {g.tile_max.x(), g.tile_max.y()}}};
+    j["groups"].push_back(jg);
+  }
+  j["ungrouped"] = {{"indices", plan.ungrouped}, {"names", names(plan.ungrouped)}};
+  return j;
+}
+
+double ParseByteSize(const std::string& text) {
+  const auto fail = [&] {
+    return Error("bad memory size '" + text +
+                 "': expected a positive number of bytes or a size such as 8G, 512M, 1.5G");
+  };
+  size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    throw fail();
+  }
+  if (used == 0 || (!std::isdigit(static_cast<unsigned char>(text[0])) && text[0] != '.'))
+    throw fail();
+  std::string unit = text.substr(used);
+  for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  double scale = 1;
+  if (!unit.empty() && std::string("KMGT").find(unit[0]) != std::string::npos) {
+    scale = std::pow(1024.0, 1 + std::string("KMGT").find(unit[0]));
+    unit.erase(0, 1);
+    if (unit == "IB") unit.erase(0, 1);
+  }
+  if (!(unit.empty() || unit == "B")) throw fail();
+  value *= scale;
+  if (!(value > 0 && std::isfinite(value))) throw fail();
+  return value;
+}
+
+std::string FormatBytes(double bytes) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+  int u = 0;
+  while (std::abs(bytes) >= 1024 && u < 4) {
+    bytes /= 1024;
+    ++u;
+  }
+  // Three significant digits: "8 GiB", "1.5 GiB", "57.1 MiB", "123 MiB".
+  char buf[64];
+  if (bytes >= 100 || u == 0)
+    std::snprintf(buf, sizeof(buf), "%.0f %s", bytes, units[u]);
+  else
+    std::snprintf(buf, sizeof(buf), "%.3g %s", bytes, units[u]);
+  return buf;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,107 @@
+#include "run_checkpoint.h"
+
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+
+#include "run_report.h"
+#include "sapmvs/atomic_file.h"
+#include "sapmvs/error.h"
+
+namespace sapmvs {
+
+namespace {
+
+void WriteJson(const std::filesystem::path& path, const nlohmann::json& j) {
+  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << std::setw(2) << j << "\n";
+    if (!f) throw Error(path.string() + ": write failed");
+  });
+}
+
+nlohmann::json ReadJson(const std::filesystem::path& path) {
+  std::ifstream f(path);
+  if (!f) throw InputError(path.string(), 0, "cannot read");
+  try {
+    return nlohmann::json::parse(f);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path.string(), 0,
+                     std::string("expected JSON written by sapmvs run (") + e.what() + ")");
+  }
+}
+
+nlohmann::json PlanRecord(const Block& block, const GroupingPlan& plan,
+                          const MatcherOptions& matcher) {
+  nlohmann::json groups = nlohmann::json::array();
+  for (const ImageGroup& g : plan.groups) {
+    nlohmann::json names = nlohmann::json::array();
+    for (const int i : g.images) names.push_back(block.images[i].name);
+    groups.push_back(names);
+  }
+  return {{"groups", groups}, {"matcher", MatcherOptionsJson(matcher)}};
+}
+
+}  // namespace
+
+RunCheckpoints::RunCheckpoints(std::filesystem::path dir, const Block& block,
+                               const GroupingPlan& plan, const MatcherOptions& matcher,
+                               bool restart)
+    : dir_(std::move(dir)) {
+  std::error_code ec;
+  if (restart) std::filesystem::remove_all(dir_, ec);
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw Error(dir_.string() + ": cannot create the checkpoint folder: " + ec.message());
+  const nlohmann::json record = PlanRecord(block, plan, matcher);
+  const std::filesystem::path plan_path = dir_ / "plan.json";
+  if (std::filesystem::exists(plan_path)) {
+    if (ReadJson(plan_path) != record) {
+      throw Error(plan_path.string() +
+                  ": holds a run with other groups or matcher options; expected the same plan "
+                  "to resume (give --restart to discard it)");
+    }
+  } else {
+    WriteJson(plan_path, record);
+  }
+}
+
+std::filesystem::path RunCheckpoints::CloudPath(int group) const {
+  char name[32];
+  std::snprintf(name, sizeof(name), "group_%03d.ply", group + 1);
+  return dir_ / name;
+}
+
+std::filesystem::path RunCheckpoints::StatusPath(int group) const {
+  char name[32];
+  std::snprintf(name, sizeof(name), "group_%03d.json", group + 1);
+  return dir_ / name;
+}
+
+bool RunCheckpoints::Done(int group) const {
+  if (!std::filesystem::exists(StatusPath(group)) || !std::filesystem::exists(CloudPath(group))) {
+    return false;
+  }
+  return ReadJson(StatusPath(group)).value("status", "") == "done";
+}
+
+GroupCheckpoint RunCheckpoints::Read(int group) const {
+  const nlohmann::json j = ReadJson(StatusPath(group));
+  GroupCheckpoint c;
+  c.points = j.value("points", 0L);
+  c.seconds = j.value("seconds", 0.0);
+  return c;
+}
+
+void RunCheckpoints::Write(int group, const PointCloud& cloud, double seconds,
+                           const MatchStats& stats) {
+  WritePly(CloudPath(group), cloud);
+  nlohmann::json j = MatchStatsJson(stats);
+  j["status"] = "done";
+  j["group"] = group + 1;
+  j["points"] = static_cast<long>(cloud.points.size());
+  j["seconds"] = seconds;
+  WriteJson(StatusPath(group), j);
+}
+
+}  // namespace sapmvs

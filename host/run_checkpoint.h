@@ -1,0 +1,39 @@
+#pragma once
+// Checkpoints of a whole-block run in DIR/groups/: plan.json (the groups and
+// the matcher options they were matched with), and per finished group
+// group_NNN.ply (its filtered cloud) and group_NNN.json (status and stats,
+// written after the cloud, so that it marks a complete group). A later run
+// with the same plan resumes; one with another plan or other options is
+// refused rather than mixing clouds matched differently.
+#include <filesystem>
+
+#include "sapmvs/block.h"
+#include "sapmvs/grouping.h"
+#include "sapmvs/matcher.h"
+#include "sapmvs/ply_io.h"
+
+namespace sapmvs {
+
+struct GroupCheckpoint {
+  long points = 0;
+  double seconds = 0;
+};
+
+class RunCheckpoints {
+ public:
+  // Creates `dir`; with `restart` removes what an earlier run left there.
+  // Throws Error naming plan.json when it records another plan or options.
+  RunCheckpoints(std::filesystem::path dir, const Block& block, const GroupingPlan& plan,
+                 const MatcherOptions& matcher, bool restart);
+
+  bool Done(int group) const;
+  GroupCheckpoint Read(int group) const;
+  void Write(int group, const PointCloud& cloud, double seconds, const MatchStats& stats);
+  std::filesystem::path CloudPath(int group) const;
+  std::filesystem::path StatusPath(int group) const;
+
+ private:
+  std::filesystem::path dir_;
+};
+
+}  // namespace sapmvs

@@ -1,0 +1,134 @@
+#include "run_report.h"
+
+#include <fstream>
+#include <iomanip>
+
+#include "sapmvs/atomic_file.h"
+#include "sapmvs/error.h"
+
+namespace sapmvs {
+
+nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
+  return {{"mode", ToString(m.mode)},
+          {"level", m.level},
+          {"cell_size", m.cell_size},
+          {"threshold", m.threshold},
+          {"threshold_before", m.threshold_before},
+          {"min_image_num", m.min_image_num},
+          {"max_angle_deg", m.max_angle_deg},
+          {"view_angle_deg", m.view_angle_deg},
+          {"window_size", m.window_size},
+          {"adaptive_sizes", m.adaptive_sizes},
+          {"features_per_block", m.features_per_block},
+          {"epipolar_distance", m.epipolar_distance},
+          {"candidates_per_feature", m.candidates_per_feature},
+          {"canny_low", m.canny_low},
+          {"canny_high", m.canny_high},
+          {"use_edges", m.use_edges},
+          {"max_wave", m.max_wave},
+          {"max_waves", m.max_waves},
+          {"depth_tolerance", m.depth_tolerance},
+          {"neighbour_radius", m.neighbour_radius},
+          {"min_neighbours", m.min_neighbours},
+          {"plane_tolerance", m.plane_tolerance},
+          {"min_cluster_size", m.min_cluster_size}};
+}
+
+nlohmann::json MatchStatsJson(const MatchStats& s) {
+  nlohmann::json j;
+  j["images"] = s.images;
+  j["features"] = s.features;
+  j["seeds"] = {{"tried", s.seeds_tried}, {"accepted", s.seeds_accepted}};
+  j["edges"] = {{"edge_pixels", s.edge_points}, {"matched", s.matched_edge_points}};
+  j["propagation"] = {{"waves", s.waves},
+                      {"candidates", s.candidates},
+                      {"largest_wave", s.largest_wave},
+                      {"patches", s.patches}};
+  nlohmann::json sizes = nlohmann::json::object();
+  for (const auto& [size, count] : s.accepted_by_size) sizes[std::to_string(size)] = count;
+  j["propagation"]["accepted_by_size"] = sizes;
+  j["filter"] = {{"points_before", s.points_before_filter},
+                 {"removed_visibility", s.removed_visibility},
+                 {"removed_neighbourhood", s.removed_neighbourhood},
+                 {"removed_clusters", s.removed_clusters},
+                 {"points", s.points}};
+  nlohmann::json stages = nlohmann::json::array();
+  for (const auto& [name, t] : s.stages) {
+    stages.push_back({{"stage", name}, {"wall_seconds", t.wall}, {"device_seconds", t.device}});
+  }
+  j["stages"] = stages;
+  nlohmann::json kernels = nlohmann::json::array();
+  for (const auto& [name, t] : s.kernels) {
+    kernels.push_back({{"kernel", name},
+                       {"launches", t.launches},
+                       {"items", t.items},
+                       {"device_seconds", t.seconds}});
+  }
+  j["kernels"] = kernels;
+  j["gsd_at_level"] = s.gsd;
+  return j;
+}
+
+void WriteRunReport(const RunOptions& options, const RunReport& report, const Block& block,
+                    const GroupingPlan& plan) {
+  nlohmann::json j;
+  j["block"] = options.block.string();
+  j["mode"] = ToString(options.matcher.mode);
+  j["level"] = options.matcher.level;
+  j["device"] = report.device;
+  j["crs"] = block.crs;
+  j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
+  j["images"] = report.images;
+  j["points"] = report.points;
+  j["total_seconds"] = report.total_seconds;
+  j["total_hms"] = FormatHms(report.total_seconds);
+  j["mean_point_spacing"] = report.mean_spacing;
+  j["density_per_unit2"] = report.density;
+  j["covered_area_unit2"] = report.area;
+  j["dsm_cell"] = report.dsm_cell;
+  j["peak_rss_bytes"] = report.peak_rss_bytes;
+  j["grouping"] = report.strategy;
+  j["matcher"] = MatcherOptionsJson(options.matcher);
+  nlohmann::json groups = nlohmann::json::array();
+  for (size_t g = 0; g < report.groups.size(); ++g) {
+    const GroupRun& r = report.groups[g];
+    nlohmann::json e = {{"group", r.index + 1},        {"images", r.images},
+                        {"points", r.points},          {"seconds", r.seconds},
+                        {"hms", FormatHms(r.seconds)}, {"from_checkpoint", r.resumed}};
+    if (g < plan.groups.size()) {
+      const Eigen::Vector2d c = plan.groups[g].center + block.origin.head<2>();
+      e["center"] = {c.x(), c.y()};
+      e["memory_estimate_bytes"] = {{"device", plan.groups[g].memory.device_bytes},
+                                    {"host", plan.groups[g].memory.host_bytes}};
+    }
+    if (g < report.merge.kept_by_group.size()) {
+      e["kept_after_merge"] = report.merge.kept_by_group[g];
+      e["kept_in_core"] = report.merge.core_by_group[g];
+    }
+    groups.push_back(e);
+  }
+  j["groups"] = groups;
+  j["merge"] = {{"input", report.merge.input},
+                {"kept", report.merge.kept},
+                {"cross_group_duplicates", report.merge.duplicates}};
+  // Matching stages (summed over the groups matched in this call, with their
+  // device time), then the run's own: plan, match (all groups), merge, ...
+  nlohmann::json matching = MatchStatsJson(report.stats);
+  nlohmann::json stages = matching["stages"];
+  for (const auto& [name, t] : report.stages) {
+    stages.push_back({{"stage", "run " + name}, {"wall_seconds", t}, {"hms", FormatHms(t)}});
+  }
+  j["stages"] = stages;
+  j["kernels"] = matching["kernels"];
+  matching.erase("stages");
+  matching.erase("kernels");
+  j["matching"] = matching;
+  const std::filesystem::path path = options.out / "report.json";
+  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << std::setw(2) << j << "\n";
+    if (!f) throw Error(path.string() + ": write failed");
+  });
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,20 @@
+#pragma once
+// DIR/report.json of `sapmvs run`, and the JSON pieces the checkpoints share.
+#include <nlohmann/json.hpp>
+
+#include "sapmvs/block.h"
+#include "sapmvs/dense_run.h"
+#include "sapmvs/grouping.h"
+#include "sapmvs/matcher.h"
+
+namespace sapmvs {
+
+// Every field of the options: what a checkpoint must agree on to be reused.
+nlohmann::json MatcherOptionsJson(const MatcherOptions& m);
+// Counts, per-stage wall/device times and kernel times of one or more groups.
+nlohmann::json MatchStatsJson(const MatchStats& s);
+// Writes options.out / "report.json" atomically.
+void WriteRunReport(const RunOptions& options, const RunReport& report, const Block& block,
+                    const GroupingPlan& plan);
+
+}  // namespace sapmvs

@@ -1,0 +1,139 @@
+#pragma once
+// Image grouping (method.md 2): a block of hundreds of images does not fit in
+// memory at once, so it is split into small groups that are matched
+// independently and merged. Two strategies:
+//   strip      (paper) runs of at most max_images consecutive images within
+//              one flight strip, the last run of a strip taking the
+//              remainder (16 -> 6+6+4, 17 -> 6+6+5: the paper's Table 3);
+//   footprint  (ours) the ground extent is tiled and each tile gets the
+//              images that see it best, across strips, so that side overlap
+//              also contributes views.
+// Both bound a group by a memory estimate as well as by a count. Groups
+// overlap on the ground; the merge gives each XY to the group whose `center`
+// is nearest.
+#include <Eigen/Core>
+#include <iosfwd>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "sapmvs/block.h"
+
+namespace sapmvs {
+
+struct MatcherOptions;
+
+enum class GroupingStrategy { kStrip, kFootprint };
+std::string ToString(GroupingStrategy s);
+// "strip" or "footprint"; throws sapmvs::Error naming the text and the
+// expected values otherwise.
+GroupingStrategy ParseGroupingStrategy(const std::string& text);
+
+struct GroupingOptions {
+  // The paper's; footprint becomes the default only once it is shown better.
+  GroupingStrategy strategy = GroupingStrategy::kStrip;
+  // Most images per group, >= 2.
+  int max_images = 6;
+  // Bytes that the device + host estimate of one group must fit in.
+  double memory_budget = 8.0 * (1ull << 30);
+  // Pyramid level the groups are matched at (MatcherOptions::level), 0..6;
+  // only the memory estimate depends on it.
+  int level = 1;
+  // Footprint strategy: tile side as a share of the median image footprint's
+  // shorter side on the ground, (0, 4]. Smaller tiles give more groups, each
+  // with views chosen for a smaller area.
+  double tile_size = 1.0;
+  // Footprint strategy: images are added to a tile's group until every point
+  // of the tile is seen by this many of them (or max_images is reached),
+  // >= 2.
+  int tile_views = 4;
+
+  // Logs the first failing condition to stderr and returns false.
+  bool Check() const;
+  // "" or the first failing condition as "what was expected (name = value)".
+  std::string Problem() const;
+};
+
+struct GroupMemory {
+  double device_bytes = 0;
+  double host_bytes = 0;
+  double Total() const { return device_bytes + host_bytes; }
+};
+
+// Memory to match `images` of `block` at `level`, in bytes. With, for image
+// i, P_i its pixels at the level (sides halved per level as
+// Intrinsics::Scaled rounds them) and C_i = ceil(w/c) ceil(h/c) its cells
+// (c = MatcherOptions::cell_size, 2 by default), and M = max_wave:
+//   device = sum_i 8 P_i                      float32 grey, resident for the
+//                                             group, + a float32 depth map
+//          + M (48 + 48 + 4 + 16 (V - 1))     one wave: NccPatch, refined
+//                                             patch, view offset, and per
+//                                             view a pair, an index, a score
+//   host   = sum_i (20 P_i + b C_i)           BGR 8-bit + float32 grey +
+//                                             edge map (mask + float3 point),
+//                                             and per cell b = 17 + 4 (V - 1)
+//                                             + sizeof(AcceptedPatch) +
+//                                             sizeof(DensePoint), about 170:
+//                                             owner + tries, three float depth
+//                                             buffers, at most one accepted
+//                                             patch with its view ids and one
+//                                             dense point
+//          + M (candidate + result + 4 (V - 1))   the wave's host side
+//          + max_i 6 w_i h_i                 loading: one full-resolution
+//                                             BGR image, raw + undistorted
+// with V = kMaxViews and w_i h_i the full-resolution size. The per-image
+// terms grow linearly with the images and by 4x per level towards full
+// resolution; the wave is bounded by max_wave and the loading peak by the
+// largest image, whatever the group. Throws Error for an index outside the
+// block or a level outside 0..6.
+GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images, int level);
+// The same for the cell size, wave size and level of `matcher`.
+GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images,
+                                const MatcherOptions& matcher);
+
+struct ImageGroup {
+  std::vector<int> images;  // indices into block.images, in flight order (strip)
+                            // or best view first (footprint)
+  int strip = -1;           // strip index (strip strategy), else -1
+  // Local-frame XY of the group's ground centre: the mean of its images'
+  // footprint centres (strip), the tile centre (footprint). The merge gives
+  // each XY to the group with the nearest center.
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  // Footprint strategy: the tile, local-frame XY; both zero for strips.
+  Eigen::Vector2d tile_min = Eigen::Vector2d::Zero();
+  Eigen::Vector2d tile_max = Eigen::Vector2d::Zero();
+  GroupMemory memory;
+};
+
+struct GroupingPlan {
+  GroupingStrategy strategy = GroupingStrategy::kStrip;
+  GroupingOptions options;               // what the plan was made with
+  std::vector<std::vector<int>> strips;  // detected strips, images in flight order
+  std::vector<ImageGroup> groups;
+  std::vector<int> ungrouped;  // images in no group (see PlanGroups)
+};
+
+// Plans the groups of `block`. Strip strategy: a strip of one image joins the
+// group nearest to it that has room, else it is left ungrouped; a run of one
+// image left at the end of a strip takes one image from the run before it (or
+// shares it, when max_images is 2), so no group has a single image; a block
+// with no strip of 2 or more images (terrestrial, convergent) is cut in block
+// order as one strip, its groups with strip -1. Footprint strategy: images without a surface
+// estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error for bad options, a block
+// of fewer than 2 images, and when 2 images do not fit memory_budget.
+GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options);
+
+// Like the paper's Table 3: group, image numbers (1-based), image names,
+// number of images, and the memory estimate of each group.
+void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out);
+// The plan as JSON; image indices are 0-based (block order), as in the API.
+nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan);
+
+// "8G", "512M", "1.5G", "64k", "1048576" (bytes; K, M, G, T are powers of
+// 1024, an optional trailing "B" or "iB" is accepted). Throws Error naming
+// `text` otherwise, or when the size is not positive.
+double ParseByteSize(const std::string& text);
+// 1536 -> "1.5 KiB".
+std::string FormatBytes(double bytes);
+
+}  // namespace sapmvs

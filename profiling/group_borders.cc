@@ -1,0 +1,159 @@
+// Does grouping cost accuracy or completeness where groups meet? Reads a
+// whole-block run (DIR/report.json, DIR/cloud.ply) and the simulator's true
+// surface, splits the ground into a border zone (within --band of the
+// boundary between two groups' cores) and the centre zone (the rest), and
+// prints for each: points, share within 1 GSD, median |dz|, coverage. Also
+// counts cross-group duplicates: points of different groups within
+// --duplicate GSDs of each other (the merge should leave none).
+//
+//   group_borders RUN_DIR --block BLOCK --truth truth/dsm.tif [--band 20]
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <unordered_map>
+
+#include "sapmvs/block_geometry.h"
+#include "sapmvs/block_reader.h"
+#include "sapmvs/error.h"
+#include "sapmvs/ply_io.h"
+#include "sapmvs/raster_io.h"
+#include "sapmvs/surface_check.h"
+
+using namespace sapmvs;
+
+namespace {
+
+// Distance from (x, y) to the boundary of the Voronoi cell of its nearest
+// centre: the smallest distance to a bisector with another centre.
+double DistanceToCoreBoundary(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
+  const Eigen::Vector2d p(x, y);
+  size_t own = 0;
+  for (size_t g = 1; g < centers.size(); ++g) {
+    if ((p - centers[g]).squaredNorm() < (p - centers[own]).squaredNorm()) own = g;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t g = 0; g < centers.size(); ++g) {
+    if (g == own) continue;
+    const double d = ((p - centers[g]).squaredNorm() - (p - centers[own]).squaredNorm()) /
+                     (2 * (centers[g] - centers[own]).norm());
+    best = std::min(best, d);
+  }
+  return best;
+}
+
+long CrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of, double r) {
+  struct Key {
+    long long x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct Hash {
+    size_t operator()(const Key& k) const {
+      return static_cast<size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
+    }
+  };
+  std::unordered_map<Key, std::vector<size_t>, Hash> grid;
+  auto key = [&](const Eigen::Vector3d& p) {
+    return Key{static_cast<long long>(std::floor(p.x() / r)),
+               static_cast<long long>(std::floor(p.y() / r)),
+               static_cast<long long>(std::floor(p.z() / r))};
+  };
+  for (size_t i = 0; i < cloud.points.size(); ++i) grid[key(cloud.points[i].position)].push_back(i);
+  long pairs = 0;
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    const Eigen::Vector3d& p = cloud.points[i].position;
+    const Key k = key(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(Key{k.x + dx, k.y + dy, k.z + dz});
+          if (it == grid.end()) continue;
+          for (const size_t j : it->second) {
+            if (j > i && group_of[j] != group_of[i] && (cloud.points[j].position - p).norm() <= r) {
+              ++pairs;
+            }
+          }
+        }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("Accuracy and completeness of a run at group borders vs group centres");
+  std::string run_dir, block_path, truth_path, zones_dir;
+  double band_gsd = 20, duplicate_gsd = 0.25;
+  int level = 1;
+  app.add_option("run", run_dir, "Output folder of `sapmvs run`")->required();
+  app.add_option("--block", block_path, "The block that was run")->required();
+  app.add_option("--truth", truth_path, "True surface raster (truth/dsm.tif)")->required();
+  app.add_option("--band", band_gsd, "Border zone half-width, block GSDs")->capture_default_str();
+  app.add_option("--duplicate", duplicate_gsd, "Cross-group duplicate distance, block GSDs")
+      ->capture_default_str();
+  app.add_option("--zones-from", zones_dir,
+                 "Take the group centres from this run instead (e.g. to measure a one-group "
+                 "run over the zones of a grouped one)");
+  app.add_option("--level", level, "Pyramid level matched (coverage cells)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const std::filesystem::path dir(run_dir);
+    std::ifstream f(dir / "report.json");
+    if (!f) throw Error((dir / "report.json").string() + ": cannot read");
+    const nlohmann::json report = nlohmann::json::parse(f);
+    std::vector<Eigen::Vector2d> centers;
+    std::vector<int> group_of;
+    for (const auto& g : report.at("groups")) {
+      centers.emplace_back(g.at("center")[0].get<double>(), g.at("center")[1].get<double>());
+      const long kept = g.at("kept_after_merge").get<long>();
+      group_of.insert(group_of.end(), kept, static_cast<int>(centers.size()) - 1);
+    }
+    const PointCloud cloud = ReadPly(dir / "cloud.ply");
+    if (!zones_dir.empty()) {
+      std::ifstream z(std::filesystem::path(zones_dir) / "report.json");
+      if (!z) throw Error(zones_dir + "/report.json: cannot read");
+      centers.clear();
+      const nlohmann::json zones = nlohmann::json::parse(z);
+      for (const auto& g : zones.at("groups")) {
+        centers.emplace_back(g.at("center")[0].get<double>(), g.at("center")[1].get<double>());
+      }
+    }
+    if (group_of.size() != cloud.points.size()) {
+      throw Error("report.json's kept_after_merge counts do not add up to cloud.ply's points");
+    }
+    const Block block = ReadBlock(block_path);
+    const GeoRaster truth = ReadGeoRaster(truth_path);
+    const double gsd = EstimateBlockGeometry(block).gsd_median;
+    const double band = band_gsd * gsd;
+    SurfaceCheckOptions so;
+    so.tolerance = gsd;
+    so.cell_size = 2 * std::ldexp(1.0, level) * gsd;
+    std::cout << "run " << run_dir << ": " << cloud.points.size() << " points, " << centers.size()
+              << " groups; GSD " << gsd << ", border band +-" << band << " (" << band_gsd
+              << " GSD)\n";
+    std::cout << "zone        points   <=1 GSD  median|dz|  coverage  (cells seen)\n";
+    for (const bool border : {true, false}) {
+      so.region = [&](double x, double y) {
+        return centers.size() > 1 && (DistanceToCoreBoundary(centers, x, y) <= band) == border;
+      };
+      if (centers.size() < 2 && border) continue;
+      if (centers.size() < 2) so.region = nullptr;
+      const SurfaceCheck s = CheckAgainstSurface(cloud, truth, block, so);
+      std::cout << std::left << std::setw(8) << (border ? "border" : "centre") << std::right
+                << std::setw(10) << s.checked << std::fixed << std::setprecision(1) << std::setw(9)
+                << 100 * s.share_within << "%" << std::setprecision(3) << std::setw(12)
+                << s.median_abs_dz << std::setprecision(1) << std::setw(9) << 100 * s.coverage
+                << "%  (" << s.cells_seen << ")\n";
+      std::cout.unsetf(std::ios::floatfield);
+    }
+    std::cout << std::setprecision(6) << "cross-group pairs within " << duplicate_gsd
+              << " GSD: " << CrossGroupPairs(cloud, group_of, duplicate_gsd * gsd) << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,174 @@
+#include "sapmvs/cloud_merge.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "sapmvs/error.h"
+
+namespace sapmvs {
+namespace {
+
+// A grid of points on z = height over [x0, x1) x [y0, y1) at `spacing`,
+// shifted by (dx, dy), with `score`.
+PointCloud Grid(double x0, double x1, double y0, double y1, double spacing, double dx, double dy,
+                double height, float score) {
+  PointCloud c;
+  c.has_scores = true;
+  for (double y = y0; y < y1; y += spacing) {
+    for (double x = x0; x < x1; x += spacing) {
+      CloudPoint p;
+      p.position = {500000.0 + x + dx, 5400000.0 + y + dy, height};
+      p.score = score;
+      c.points.push_back(p);
+    }
+  }
+  return c;
+}
+
+long CrossGroupPairsWithin(const PointCloud& merged, const std::vector<int>& group_of, double r) {
+  long pairs = 0;
+  for (size_t i = 0; i < merged.points.size(); ++i) {
+    for (size_t j = i + 1; j < merged.points.size(); ++j) {
+      if (group_of[i] != group_of[j] &&
+          (merged.points[i].position - merged.points[j].position).norm() <= r) {
+        ++pairs;
+      }
+    }
+  }
+  return pairs;
+}
+
+TEST(CloudMerge, OverlapKeepsEachSurfacePointOnceWithoutHoles) {
+  // Two groups matched the same plane over overlapping strips, offset by a
+  // third of the spacing (different reference images sample it differently).
+  const double s = 0.5;
+  const PointCloud a = Grid(0, 20, 0, 10, s, 0, 0, 100, 0.9f);
+  const PointCloud b = Grid(12, 32, 0, 10, s, s / 3, s / 3, 100, 0.8f);
+  std::vector<GroupCloud> groups = {{&a, {500010.0, 5400005.0}}, {&b, {500022.0, 5400005.0}}};
+  MergeOptions o;
+  o.radius = s;
+  MergeStats st;
+  const PointCloud m = MergeGroupClouds(groups, o, &st);
+  EXPECT_EQ(st.input, static_cast<long>(a.points.size() + b.points.size()));
+  EXPECT_EQ(st.kept + st.duplicates, st.input);
+  EXPECT_EQ(st.kept, static_cast<long>(m.points.size()));
+  EXPECT_GT(st.duplicates, 0);
+  // The output lists group a's kept points first, then b's.
+  std::vector<int> group_of;
+  for (long k = 0; k < st.kept_by_group[0]; ++k) group_of.push_back(0);
+  for (long k = 0; k < st.kept_by_group[1]; ++k) group_of.push_back(1);
+  // Allowing the 0.25 GSD of the acceptance, with radius = 1 point spacing.
+  EXPECT_EQ(CrossGroupPairsWithin(m, group_of, 0.25 * s), 0);
+  EXPECT_EQ(CrossGroupPairsWithin(m, group_of, s), 0);
+  // No hole: every point of either input has a merged point within the radius.
+  for (const PointCloud* c : {&a, &b}) {
+    for (const CloudPoint& p : c->points) {
+      bool near = false;
+      for (const CloudPoint& q : m.points) {
+        if ((q.position - p.position).norm() <= s) {
+          near = true;
+          break;
+        }
+      }
+      ASSERT_TRUE(near) << p.position.transpose();
+    }
+  }
+  // The core decides the overlap: left of x = 16 (midway between the
+  // centres) is a's, right of it b's.
+  for (size_t i = 0; i < m.points.size(); ++i) {
+    const double x = m.points[i].position.x() - 500000.0;
+    if (x < 15.5) {
+      EXPECT_EQ(group_of[i], 0) << x;
+    }
+    if (x > 16.5) {
+      EXPECT_EQ(group_of[i], 1) << x;
+    }
+  }
+}
+
+TEST(CloudMerge, AHoleInTheOwnerIsFilledByTheOtherGroup) {
+  const double s = 0.5;
+  PointCloud a = Grid(0, 20, 0, 10, s, 0, 0, 100, 0.9f);
+  // Group a matched nothing in [14, 18) x [2, 6): b's points must fill it.
+  std::vector<CloudPoint> kept;
+  for (const CloudPoint& p : a.points) {
+    const double x = p.position.x() - 500000.0, y = p.position.y() - 5400000.0;
+    if (!(x >= 14 && x < 18 && y >= 2 && y < 6)) kept.push_back(p);
+  }
+  a.points = kept;
+  const PointCloud b = Grid(10, 30, 0, 10, s, 0.1, 0.1, 100, 0.5f);
+  std::vector<GroupCloud> groups = {{&a, {500000.0, 5400005.0}}, {&b, {500040.0, 5400005.0}}};
+  MergeOptions o;
+  o.radius = s;
+  const PointCloud m = MergeGroupClouds(groups, o);
+  long in_hole = 0;
+  for (const CloudPoint& p : m.points) {
+    const double x = p.position.x() - 500000.0, y = p.position.y() - 5400000.0;
+    if (x >= 14.6 && x < 17.4 && y >= 2.6 && y < 5.4) ++in_hole;
+  }
+  EXPECT_GE(in_hole, 5 * 5);  // b's grid points well inside the hole
+}
+
+TEST(CloudMerge, SurfacesAtOtherHeightsAreNotDuplicates) {
+  // A roof 5 m above the ground seen by another group is another surface.
+  const PointCloud a = Grid(0, 5, 0, 5, 0.5, 0, 0, 100, 0.9f);
+  const PointCloud b = Grid(0, 5, 0, 5, 0.5, 0, 0, 105, 0.9f);
+  std::vector<GroupCloud> groups = {{&a, {500000.0, 5400000.0}}, {&b, {500100.0, 5400000.0}}};
+  MergeOptions o;
+  o.radius = 0.5;
+  MergeStats st;
+  const PointCloud m = MergeGroupClouds(groups, o, &st);
+  EXPECT_EQ(st.duplicates, 0);
+  EXPECT_EQ(m.points.size(), a.points.size() + b.points.size());
+}
+
+TEST(CloudMerge, PointsOfOneGroupAreNeverDroppedForEachOther) {
+  PointCloud a = Grid(0, 3, 0, 3, 0.1, 0, 0, 100, 0.9f);  // denser than the radius
+  std::vector<GroupCloud> groups = {{&a, {500000.0, 5400000.0}}};
+  MergeOptions o;
+  o.radius = 0.5;
+  EXPECT_EQ(MergeGroupClouds(groups, o).points.size(), a.points.size());
+}
+
+TEST(CloudMerge, SameInputsGiveTheSameOutput) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, 10);
+  PointCloud a, b;
+  for (int i = 0; i < 997; ++i) {
+    CloudPoint p;
+    p.position = {u(rng), u(rng), 0.1 * u(rng)};
+    p.score = static_cast<float>(u(rng));
+    (i % 2 ? a : b).points.push_back(p);
+  }
+  std::vector<GroupCloud> groups = {{&a, {2.0, 5.0}}, {&b, {8.0, 5.0}}};
+  MergeOptions o;
+  o.radius = 0.3;
+  const PointCloud m1 = MergeGroupClouds(groups, o);
+  const PointCloud m2 = MergeGroupClouds(groups, o);
+  ASSERT_EQ(m1.points.size(), m2.points.size());
+  for (size_t i = 0; i < m1.points.size(); ++i) {
+    EXPECT_EQ(m1.points[i].position, m2.points[i].position);
+  }
+}
+
+TEST(CloudMerge, BadRadiusIsAnError) {
+  PointCloud a;
+  std::vector<GroupCloud> groups = {{&a, {0, 0}}};
+  MergeOptions o;
+  for (const double r : {0.0, -1.0, std::nan("")}) {
+    o.radius = r;
+    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << r;
+  }
+}
+
+TEST(CloudMerge, CoreOwnerIsTheNearestCentre) {
+  PointCloud a;
+  std::vector<GroupCloud> groups = {{&a, {0, 0}}, {&a, {10, 0}}, {&a, {0, 10}}};
+  EXPECT_EQ(CoreOwner(groups, 1, 1), 0);
+  EXPECT_EQ(CoreOwner(groups, 9, 1), 1);
+  EXPECT_EQ(CoreOwner(groups, 1, 9), 2);
+}
+
+}  // namespace
+}  // namespace sapmvs

@@ -1,0 +1,444 @@
+#include "sapmvs/grouping.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+
+#include "sapmvs/block_geometry.h"
+#include "sapmvs/error.h"
+#include "sim_presets.h"
+#include "strip_detection.h"
+
+namespace sapmvs {
+namespace {
+
+// The cameras `sapmvs simulate --preset NAME` renders, as a block without
+// images (grouping never reads pixels). The simulator's mean ground is local
+// z = 0, i.e. world z = the offset's.
+struct SimBlock {
+  Block block;
+  std::vector<int> strip_of;  // the simulator's strip per image
+};
+
+SimBlock MakeSimBlock(const std::string& preset, bool cross_strip = false,
+                      const std::vector<int>& keep_strips = {}) {
+  const sim::Preset p = sim::FindPreset(preset);
+  const sim::FlightPlan plan =
+      sim::PlanFlight(p, p.camera, cross_strip, p.flight.exposure, /*seed=*/1);
+  const Intrinsics k = Intrinsics::FromFocalAndPixel(p.camera.focal_mm, p.camera.pixel_um,
+                                                     p.camera.width, p.camera.height);
+  const Eigen::Vector3d offset = sim::WorldOffset(plan.scene_width, plan.scene_height);
+  SimBlock s;
+  s.block.source = "sim/" + preset;
+  s.block.format = "sim";
+  for (const PlannedImage& im : plan.images) {
+    if (!keep_strips.empty() &&
+        std::find(keep_strips.begin(), keep_strips.end(), im.strip) == keep_strips.end())
+      continue;
+    BlockImage bi;
+    bi.name = im.name;
+    bi.camera_name = "camera";
+    bi.camera = Camera::FromAngles(k, im.center + offset, im.omega, im.phi, im.kappa,
+                                   AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
+    s.block.images.push_back(bi);
+    s.strip_of.push_back(im.strip);
+  }
+  s.block.ground_height = offset.z();
+  s.block.origin = ChooseLocalOrigin(s.block.images);
+  return s;
+}
+
+std::vector<size_t> Sizes(const GroupingPlan& plan) {
+  std::vector<size_t> sizes;
+  for (const ImageGroup& g : plan.groups) sizes.push_back(g.images.size());
+  return sizes;
+}
+
+// Strips as name sequences, sorted, so that blocks listing the same images in
+// different orders compare equal.
+std::vector<std::vector<std::string>> StripNames(const Block& block,
+                                                 const std::vector<std::vector<int>>& strips) {
+  std::vector<std::vector<std::string>> out;
+  for (const auto& s : strips) {
+    out.emplace_back();
+    for (const int i : s) out.back().push_back(block.images[i].name);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The simulator's strips, in its (flight) order.
+std::vector<std::vector<int>> TrueStrips(const SimBlock& s) {
+  std::map<int, std::vector<int>> by;
+  for (size_t i = 0; i < s.strip_of.size(); ++i) by[s.strip_of[i]].push_back(static_cast<int>(i));
+  std::vector<std::vector<int>> out;
+  for (auto& [strip, ids] : by) out.push_back(ids);
+  return out;
+}
+
+TEST(GroupingTable3, CampusStripStrategyMatchesThePaper) {
+  const SimBlock s = MakeSimBlock("campus");
+  ASSERT_EQ(s.block.images.size(), 67u);
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  EXPECT_EQ(plan.strategy, GroupingStrategy::kStrip);
+  EXPECT_EQ(plan.strips, TrueStrips(s));
+  EXPECT_EQ(Sizes(plan), (std::vector<size_t>{6, 6, 4, 6, 6, 5, 6, 6, 6, 6, 6, 4}));
+  // Table 3: the groups are the images 0..66 cut in order.
+  std::vector<int> all;
+  for (const ImageGroup& g : plan.groups) {
+    for (size_t k = 1; k < g.images.size(); ++k) EXPECT_EQ(g.images[k], g.images[k - 1] + 1);
+    all.insert(all.end(), g.images.begin(), g.images.end());
+    EXPECT_GE(g.strip, 0);
+    EXPECT_EQ(s.strip_of[g.images[0]], g.strip);
+    EXPECT_GT(g.memory.device_bytes, 0);
+    EXPECT_GT(g.memory.host_bytes, 0);
+  }
+  std::vector<int> expected(67);
+  std::iota(expected.begin(), expected.end(), 0);
+  EXPECT_EQ(all, expected);
+  EXPECT_TRUE(plan.ungrouped.empty());
+}
+
+TEST(GroupingTable3, GroupCentresLieOnTheirImagesFootprints) {
+  const SimBlock s = MakeSimBlock("campus");
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  for (const ImageGroup& g : plan.groups) {
+    // Nadir images: the footprint centre is near the camera's XY.
+    Eigen::Vector2d cams = Eigen::Vector2d::Zero();
+    for (const int i : g.images)
+      cams += (s.block.images[i].camera.center() - s.block.origin).head<2>();
+    cams /= static_cast<double>(g.images.size());
+    EXPECT_LT((g.center - cams).norm(), 0.05 * 700) << g.center.transpose();
+  }
+}
+
+TEST(GroupingStrips, CrossStripIsItsOwnStrip) {
+  const SimBlock s = MakeSimBlock("campus", /*cross_strip=*/true);
+  ASSERT_GT(s.block.images.size(), 67u);
+  const std::vector<std::vector<int>> strips = DetectStrips(s.block);
+  EXPECT_EQ(strips, TrueStrips(s));
+  ASSERT_EQ(strips.size(), 5u);
+  EXPECT_EQ(strips[4].size(), s.block.images.size() - 67);
+}
+
+TEST(GroupingStrips, ShuffledOrderGivesTheSameStripsInFlightOrder) {
+  SimBlock s = MakeSimBlock("campus", /*cross_strip=*/true);
+  const auto expected = StripNames(s.block, TrueStrips(s));
+  std::mt19937 rng(7);
+  std::shuffle(s.block.images.begin(), s.block.images.end(), rng);
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  EXPECT_EQ(StripNames(s.block, plan.strips), expected);
+  // Same cut as in flight order: 6+6+4, 6+6+5, 6+6+6, 6+6+4 and the cross strip's.
+  std::vector<size_t> sizes = Sizes(plan);
+  std::sort(sizes.begin(), sizes.end());
+  SimBlock ordered = MakeSimBlock("campus", true);
+  std::vector<size_t> want = Sizes(PlanGroups(ordered.block, GroupingOptions{}));
+  std::sort(want.begin(), want.end());
+  EXPECT_EQ(sizes, want);
+}
+
+TEST(GroupingStrips, SingleStrip) {
+  const SimBlock s = MakeSimBlock("campus", false, {2});
+  ASSERT_EQ(s.block.images.size(), 18u);
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  ASSERT_EQ(plan.strips.size(), 1u);
+  std::vector<int> all(18);
+  std::iota(all.begin(), all.end(), 0);
+  EXPECT_EQ(plan.strips[0], all);
+  EXPECT_EQ(Sizes(plan), (std::vector<size_t>{6, 6, 6}));
+}
+
+TEST(GroupingStrips, StripFlownBackwardsKeepsFlightOrder) {
+  // Strip 1 flies -X: its images in flight order have decreasing X.
+  const SimBlock s = MakeSimBlock("campus", false, {1});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  ASSERT_EQ(plan.strips.size(), 1u);
+  const auto& strip = plan.strips[0];
+  for (size_t k = 1; k < strip.size(); ++k) {
+    EXPECT_EQ(strip[k], strip[k - 1] + 1);
+    EXPECT_LT(s.block.images[strip[k]].camera.center().x(),
+              s.block.images[strip[k - 1]].camera.center().x());
+  }
+  // Shuffled, the image x axis (kappa 180: -X) still gives the flight order.
+  SimBlock shuffled = s;
+  std::mt19937 rng(3);
+  std::shuffle(shuffled.block.images.begin(), shuffled.block.images.end(), rng);
+  const auto strips = PlanGroups(shuffled.block, GroupingOptions{}).strips;
+  EXPECT_EQ(StripNames(shuffled.block, strips), StripNames(s.block, plan.strips));
+}
+
+TEST(GroupingStrips, RemainderOfOneBorrowsFromThePreviousRun) {
+  // 13 images: 6 + 6 + 1 would leave an image with nothing to match.
+  SimBlock s = MakeSimBlock("campus", false, {0});
+  s.block.images.resize(13);
+  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{})), (std::vector<size_t>{6, 5, 2}));
+  GroupingOptions two;
+  two.max_images = 2;
+  s.block.images.resize(5);
+  const GroupingPlan plan = PlanGroups(s.block, two);
+  ASSERT_EQ(plan.groups.size(), 3u);
+  EXPECT_EQ(plan.groups[2].images, (std::vector<int>{3, 4}));  // shares image 3
+}
+
+TEST(GroupingStrips, LoneImageJoinsTheNearestGroup) {
+  SimBlock s = MakeSimBlock("campus", false, {0});
+  // A stray exposure turned by 90 deg over image 11. Its own group (6..11)
+  // is full, and the 4 (12..15) is nearer than the first 6.
+  BlockImage stray = s.block.images[11];
+  stray.name = "STRAY";
+  const Camera& c = stray.camera;
+  stray.camera = Camera::FromAngles(c.intrinsics(), c.center(), 0, 0, 90,
+                                    AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
+  s.block.images.push_back(stray);
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  EXPECT_EQ(plan.strips.size(), 2u);
+  EXPECT_TRUE(plan.ungrouped.empty());
+  int holder = -1;
+  for (size_t g = 0; g < plan.groups.size(); ++g)
+    for (const int i : plan.groups[g].images)
+      if (i == 16) holder = static_cast<int>(g);
+  EXPECT_EQ(holder, 2);
+}
+
+// Ground points (local XY on the mean ground) and the images that see them.
+struct GroundSample {
+  Eigen::Vector2d xy;
+  std::vector<int> seen_by;
+};
+
+std::vector<GroundSample> SampleGround(const Block& block, int n) {
+  const BlockGeometry g = EstimateBlockGeometry(block);
+  const Eigen::Vector2d lo = (g.extent_min - block.origin).head<2>();
+  const Eigen::Vector2d hi = (g.extent_max - block.origin).head<2>();
+  std::vector<GroundSample> out;
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < 2 * n; ++x) {
+      GroundSample s;
+      s.xy = lo + Eigen::Vector2d((x + 0.5) / (2 * n), (y + 0.5) / n).cwiseProduct(hi - lo);
+      const Eigen::Vector3d p(s.xy.x() + block.origin.x(), s.xy.y() + block.origin.y(),
+                              *block.ground_height);
+      for (size_t i = 0; i < block.images.size(); ++i) {
+        const Camera& cam = block.images[i].camera;
+        if (cam.InImage(cam.Project(p))) s.seen_by.push_back(static_cast<int>(i));
+      }
+      out.push_back(std::move(s));
+    }
+  }
+  return out;
+}
+
+int NearestGroup(const GroupingPlan& plan, const Eigen::Vector2d& xy) {
+  int best = -1;
+  for (size_t g = 0; g < plan.groups.size(); ++g)
+    if (best < 0 || (plan.groups[g].center - xy).norm() < (plan.groups[best].center - xy).norm())
+      best = static_cast<int>(g);
+  return best;
+}
+
+TEST(GroupingFootprint, EveryGroundPointSeenTwiceIsOwnedByAGroupThatSeesIt) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  o.strategy = GroupingStrategy::kFootprint;
+  const GroupingPlan plan = PlanGroups(s.block, o);
+  ASSERT_FALSE(plan.groups.empty());
+  int matchable = 0, in_tile = 0, owner_sees = 0;
+  for (const GroundSample& p : SampleGround(s.block, 40)) {
+    if (p.seen_by.size() < 2) continue;
+    ++matchable;
+    bool tiled = false;
+    for (const ImageGroup& g : plan.groups)
+      tiled |=
+          (p.xy.array() >= g.tile_min.array()).all() && (p.xy.array() <= g.tile_max.array()).all();
+    in_tile += tiled;
+    // The merge's owner (nearest centre) must have >= 2 views of the point.
+    const ImageGroup& owner = plan.groups[NearestGroup(plan, p.xy)];
+    int views = 0;
+    for (const int i : owner.images) views += std::count(p.seen_by.begin(), p.seen_by.end(), i) > 0;
+    owner_sees += views >= 2;
+  }
+  ASSERT_GT(matchable, 1000);
+  EXPECT_EQ(in_tile, matchable);
+  EXPECT_EQ(owner_sees, matchable) << owner_sees << " of " << matchable;
+}
+
+TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  o.strategy = GroupingStrategy::kFootprint;
+  o.max_images = 5;
+  o.tile_views = 5;
+  // Room for 3 images of the block, not 4.
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, o.level).Total() + 1;
+  ASSERT_GT(EstimateGroupMemory(s.block, {0, 1, 2, 3}, o.level).Total(), o.memory_budget);
+  const GroupingPlan plan = PlanGroups(s.block, o);
+  ASSERT_FALSE(plan.groups.empty());
+  for (const ImageGroup& g : plan.groups) {
+    EXPECT_GE(g.images.size(), 2u);
+    EXPECT_LE(g.images.size(), 3u);
+    EXPECT_LE(g.memory.Total(), o.memory_budget);
+    EXPECT_EQ(g.strip, -1);
+    EXPECT_TRUE((g.center.array() > g.tile_min.array()).all());
+    EXPECT_TRUE((g.center.array() < g.tile_max.array()).all());
+  }
+  o.memory_budget = 8.0 * (1ull << 30);
+  for (const ImageGroup& g : PlanGroups(s.block, o).groups) EXPECT_LE(g.images.size(), 5u);
+}
+
+TEST(GroupingFootprint, SideOverlapBringsImagesOfNeighbouringStrips) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  o.strategy = GroupingStrategy::kFootprint;
+  const GroupingPlan plan = PlanGroups(s.block, o);
+  int mixed = 0;
+  for (const ImageGroup& g : plan.groups) {
+    std::set<int> strips;
+    for (const int i : g.images) strips.insert(s.strip_of[i]);
+    mixed += strips.size() >= 2;
+  }
+  EXPECT_GE(mixed, static_cast<int>(plan.groups.size()) / 3)
+      << mixed << " of " << plan.groups.size();
+}
+
+TEST(GroupingMemory, GrowsLinearlyWithImages) {
+  const SimBlock s = MakeSimBlock("campus");
+  const GroupMemory none = EstimateGroupMemory(s.block, {}, 1);
+  const GroupMemory one = EstimateGroupMemory(s.block, {0}, 1);
+  const GroupMemory two = EstimateGroupMemory(s.block, {0, 1}, 1);
+  const GroupMemory six = EstimateGroupMemory(s.block, {0, 1, 2, 3, 4, 5}, 1);
+  const double device_per_image = one.device_bytes - none.device_bytes;
+  EXPECT_GT(device_per_image, 0);
+  EXPECT_DOUBLE_EQ(six.device_bytes - none.device_bytes, 6 * device_per_image);
+  // The loading peak is the largest image's, so host grows from one image on.
+  const double host_per_image = two.host_bytes - one.host_bytes;
+  EXPECT_GT(host_per_image, 0);
+  EXPECT_DOUBLE_EQ(six.host_bytes - one.host_bytes, 5 * host_per_image);
+  // A 972 x 648 image at level 1: 486 x 324 float32 grey + depth map.
+  EXPECT_DOUBLE_EQ(device_per_image, 8.0 * 486 * 324);
+}
+
+TEST(GroupingMemory, GrowsFourTimesPerLevelTowardsFullResolution) {
+  const SimBlock s = MakeSimBlock("campus");
+  auto per_image = [&](int level) {
+    const GroupMemory one = EstimateGroupMemory(s.block, {0}, level);
+    const GroupMemory two = EstimateGroupMemory(s.block, {0, 1}, level);
+    return std::make_pair(two.device_bytes - one.device_bytes, two.host_bytes - one.host_bytes);
+  };
+  const auto l0 = per_image(0), l1 = per_image(1), l2 = per_image(2);
+  // 972 x 648 halves exactly to 486 x 324; the 2 x 2 cell grid of 243 x 162
+  // pixels rounds up, so level 2 is within 1 %.
+  EXPECT_DOUBLE_EQ(l0.first, 4 * l1.first);
+  EXPECT_DOUBLE_EQ(l0.second, 4 * l1.second);
+  EXPECT_DOUBLE_EQ(l1.first, 4 * l2.first);
+  EXPECT_NEAR(l1.second, 4 * l2.second, 0.01 * l1.second);
+}
+
+TEST(GroupingMemory, TinyBudgetIsAClearError) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  o.memory_budget = 1 << 20;
+  try {
+    PlanGroups(s.block, o);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("memory budget 1 MiB is too small"), std::string::npos) << what;
+    EXPECT_NE(what.find("2 images"), std::string::npos) << what;
+    EXPECT_NE(what.find("level 1"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  EXPECT_THROW(EstimateGroupMemory(s.block, {0, 67}, 1), Error);
+  EXPECT_THROW(EstimateGroupMemory(s.block, {0}, 7), Error);
+}
+
+TEST(GroupingMemory, BudgetShortensTheRunsOfAStrip) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + 1;
+  const GroupingPlan plan = PlanGroups(s.block, o);
+  // 16 -> 4+4+4+4, 17 -> 4+4+4+3+2, 18 -> 4+4+4+4+2, 16 -> 4+4+4+4.
+  EXPECT_EQ(Sizes(plan),
+            (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 2, 4, 4, 4, 4, 2, 4, 4, 4, 4}));
+  for (const ImageGroup& g : plan.groups) EXPECT_LE(g.memory.Total(), o.memory_budget);
+}
+
+TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {
+  EXPECT_TRUE(GroupingOptions{}.Check());
+  EXPECT_EQ(GroupingOptions{}.Problem(), "");
+  auto problem = [](auto set) {
+    GroupingOptions o;
+    set(o);
+    return o.Problem();
+  };
+  EXPECT_NE(problem([](GroupingOptions& o) { o.max_images = 1; }).find("max_images = 1"),
+            std::string::npos);
+  EXPECT_EQ(problem([](GroupingOptions& o) { o.max_images = 2; }), "");
+  EXPECT_NE(problem([](GroupingOptions& o) { o.memory_budget = 0; }).find("memory_budget"),
+            std::string::npos);
+  EXPECT_NE(problem([](GroupingOptions& o) { o.memory_budget = NAN; }).find("memory_budget"),
+            std::string::npos);
+  EXPECT_NE(problem([](GroupingOptions& o) { o.level = -1; }).find("level = -1"),
+            std::string::npos);
+  EXPECT_NE(problem([](GroupingOptions& o) { o.level = 7; }).find("level = 7"), std::string::npos);
+  EXPECT_EQ(problem([](GroupingOptions& o) { o.level = 6; }), "");
+  EXPECT_NE(problem([](GroupingOptions& o) { o.tile_size = 0; }).find("tile_size"),
+            std::string::npos);
+  EXPECT_NE(problem([](GroupingOptions& o) { o.tile_size = 4.5; }).find("tile_size"),
+            std::string::npos);
+  EXPECT_NE(problem([](GroupingOptions& o) { o.tile_views = 1; }).find("tile_views = 1"),
+            std::string::npos);
+  // Above max_images it only means "as many as fit".
+  EXPECT_EQ(problem([](GroupingOptions& o) { o.tile_views = 7; }), "");
+  GroupingOptions bad;
+  bad.max_images = 0;
+  EXPECT_FALSE(bad.Check());
+  const SimBlock s = MakeSimBlock("tiny");
+  EXPECT_THROW(PlanGroups(s.block, bad), Error);
+}
+
+TEST(GroupingOptions, StrategyNames) {
+  EXPECT_EQ(ParseGroupingStrategy("strip"), GroupingStrategy::kStrip);
+  EXPECT_EQ(ParseGroupingStrategy("footprint"), GroupingStrategy::kFootprint);
+  EXPECT_EQ(ToString(GroupingStrategy::kFootprint), "footprint");
+  try {
+    ParseGroupingStrategy("strips");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "unknown grouping strategy 'strips': expected strip or footprint");
+  }
+}
+
+TEST(GroupingOptions, ByteSizes) {
+  EXPECT_DOUBLE_EQ(ParseByteSize("8G"), 8.0 * (1ull << 30));
+  EXPECT_DOUBLE_EQ(ParseByteSize("512M"), 512.0 * (1 << 20));
+  EXPECT_DOUBLE_EQ(ParseByteSize("1.5G"), 1.5 * (1ull << 30));
+  EXPECT_DOUBLE_EQ(ParseByteSize("1048576"), 1048576.0);
+  EXPECT_DOUBLE_EQ(ParseByteSize("64k"), 65536.0);
+  EXPECT_DOUBLE_EQ(ParseByteSize("2GiB"), 2.0 * (1ull << 30));
+  EXPECT_DOUBLE_EQ(ParseByteSize("3GB"), 3.0 * (1ull << 30));
+  for (const char* bad : {"", "abc", "-1G", "8X", "G", "0", "nan", "inf", "8 G", "1e400"}) {
+    try {
+      ParseByteSize(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("'") + bad + "'"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(FormatBytes(8.0 * (1ull << 30)), "8 GiB");
+  EXPECT_EQ(FormatBytes(1536), "1.5 KiB");
+  EXPECT_EQ(FormatBytes(57.14 * (1 << 20)), "57.1 MiB");
+  EXPECT_EQ(FormatBytes(100), "100 B");
+}
+
+TEST(GroupingPlan, TooFewImages) {
+  SimBlock s = MakeSimBlock("tiny");
+  s.block.images.resize(1);
+  EXPECT_THROW(PlanGroups(s.block, GroupingOptions{}), Error);
+}
+
+}  // namespace
+}  // namespace sapmvs
