@@ -131,6 +131,7 @@ ErrorRow ComputeErrorRow(const std::vector<double>& dz, double tolerance, double
   row.threshold = threshold;
   double sum = 0, sum2 = 0, max_abs = 0;
   long within = 0;
+  std::vector<double> abs_kept;
   for (double d : dz) {
     if (std::isnan(d)) continue;
     const double a = std::abs(d);
@@ -143,6 +144,7 @@ ErrorRow ComputeErrorRow(const std::vector<double>& dz, double tolerance, double
     sum2 += d * d;
     max_abs = std::max(max_abs, a);
     within += a <= tolerance;
+    abs_kept.push_back(a);
   }
   if (row.checkpoints > 0) {
     const double n = static_cast<double>(row.checkpoints);
@@ -150,6 +152,13 @@ ErrorRow ComputeErrorRow(const std::vector<double>& dz, double tolerance, double
     row.max_abs = max_abs;
     row.mean = sum / n;
     row.within = within / n;
+    const size_t half = abs_kept.size() / 2;
+    std::nth_element(abs_kept.begin(), abs_kept.begin() + half, abs_kept.end());
+    row.median_abs = abs_kept[half];
+    if (abs_kept.size() % 2 == 0) {
+      row.median_abs =
+          0.5 * (row.median_abs + *std::max_element(abs_kept.begin(), abs_kept.begin() + half));
+    }
   }
   return row;
 }

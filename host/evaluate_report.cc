@@ -55,14 +55,15 @@ void PrintEvaluationTable(const EvaluationReport& r, std::ostream& out) {
   out << "\n";
   char line[256];
   const std::string within = "within " + Fmt("%g", r.tolerance);
-  std::snprintf(line, sizeof line, "%-16s %12s %12s %12s %12s %12s\n", "threshold", "checkpoints",
-                "RMSE", "max", "mean", within.c_str());
+  std::snprintf(line, sizeof line, "%-16s %12s %12s %12s %12s %12s %12s\n", "threshold",
+                "checkpoints", "RMSE", "max", "mean", "median |dz|", within.c_str());
   out << line;
   for (const ErrorRow& row : r.rows) {
-    std::snprintf(line, sizeof line, "%-16s %12ld %12s %12s %12s %12s\n",
+    std::snprintf(line, sizeof line, "%-16s %12ld %12s %12s %12s %12s %12s\n",
                   ThresholdLabel(row.threshold).c_str(), row.checkpoints,
                   Fmt("%.6f", row.rmse).c_str(), Fmt("%.6f", row.max_abs).c_str(),
-                  Fmt("%.6f", row.mean).c_str(), Fmt("%.1f%%", 100 * row.within).c_str());
+                  Fmt("%.6f", row.mean).c_str(), Fmt("%.6f", row.median_abs).c_str(),
+                  Fmt("%.1f%%", 100 * row.within).c_str());
     out << line;
   }
   if (r.completeness) {
@@ -96,6 +97,7 @@ void WriteEvaluationJson(const EvaluationReport& r, const std::filesystem::path&
                          {"rmse", Number(row.rmse)},
                          {"max_abs", Number(row.max_abs)},
                          {"mean", Number(row.mean)},
+                         {"median_abs", Number(row.median_abs)},
                          {"within_tolerance", Number(row.within)}});
   }
   if (r.completeness) {

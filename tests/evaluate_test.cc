@@ -70,16 +70,21 @@ TEST(EvaluateRow, StatisticsOfAHandMadeSet) {
   EXPECT_DOUBLE_EQ(all.max_abs, 10);
   EXPECT_DOUBLE_EQ(all.mean, (0.5 - 1.5 + 3 - 0.2 + 10) / 5);
   EXPECT_DOUBLE_EQ(all.within, 2.0 / 5);
+  EXPECT_DOUBLE_EQ(all.median_abs, 1.5);  // of 0.2 0.5 1.5 3 10
   const ErrorRow kept = ComputeErrorRow(dz, 1.0, 2.0);
   EXPECT_EQ(kept.checkpoints, 3);
   EXPECT_EQ(kept.dropped, 2);
   EXPECT_DOUBLE_EQ(kept.rmse, std::sqrt((0.25 + 2.25 + 0.04) / 3));
   EXPECT_DOUBLE_EQ(kept.max_abs, 1.5);
+  EXPECT_DOUBLE_EQ(kept.median_abs, 0.5);  // of 0.2 0.5 1.5
+  // An even count: the mean of the middle two (0.5 and 1.5 of 0.2 0.5 1.5 3).
+  EXPECT_DOUBLE_EQ(ComputeErrorRow(dz, 1.0, 3.0).median_abs, 1.0);
   // |dz| == T is kept: the paper drops |dz| > T.
   EXPECT_EQ(ComputeErrorRow(dz, 1.0, 3.0).checkpoints, 4);
   const ErrorRow none = ComputeErrorRow({kNaN}, 1.0);
   EXPECT_EQ(none.checkpoints, 0);
   EXPECT_TRUE(std::isnan(none.rmse));
+  EXPECT_TRUE(std::isnan(none.median_abs));
 }
 
 // Cloud points at the centres of the LiDAR grid cells, away from its border,

@@ -88,6 +88,8 @@ struct ErrorRow {
   double rmse = std::numeric_limits<double>::quiet_NaN();     // sqrt(mean dz^2)
   double max_abs = std::numeric_limits<double>::quiet_NaN();  // largest |dz|
   double mean = std::numeric_limits<double>::quiet_NaN();     // mean dz (> 0: cloud above)
+  // Median |dz|: the typical error, which a few gross errors do not move.
+  double median_abs = std::numeric_limits<double>::quiet_NaN();
   // Share of the checkpoints with |dz| <= tolerance, 0..1.
   double within = std::numeric_limits<double>::quiet_NaN();
 };
