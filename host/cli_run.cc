@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "cli.h"
+#include "run_profile.h"
 #include "sapmvs/dense_run.h"
 
 namespace sapmvs::cli {
@@ -17,6 +18,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   auto no_edges = std::make_shared<bool>(false);
   auto strategy = std::make_shared<std::string>("strip");
   auto budget = std::make_shared<std::string>("8G");
+  auto profile = std::make_shared<std::string>();
   MatcherOptions& m = o->matcher;
   CLI::App* cmd = app.add_subcommand(
       "run", "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json");
@@ -89,7 +91,13 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--dsm-fill", o->dsm.fill_passes, "DSM gap-filling passes")
       ->capture_default_str();
-  cmd->callback([o, mode, no_edges, strategy, budget, &global] {
+  CLI::Option* profile_option =
+      cmd->add_option("--profile", *profile,
+                      "Profile the kernels and phases: print tables, write FILE (CSV) and its "
+                      ".json (default DIR/profile.csv)")
+          ->expected(0, 1);
+  cmd->callback([o, mode, no_edges, strategy, budget, profile, profile_option, &global] {
+    o->profile = profile_option->count() > 0;
     o->grouping.strategy = ParseGroupingStrategy(*strategy);
     o->grouping.memory_budget = ParseByteSize(*budget);
     o->matcher.mode = ParseMatchMode(*mode);
@@ -97,6 +105,13 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
     o->matcher.progress = !global.quiet;
     const RunReport report = RunDense(*o);
     PrintRunSummary(report, std::cout);
+    if (o->profile) {
+      PrintProfile(report, std::cout);
+      const std::filesystem::path csv =
+          profile->empty() ? o->out / "profile.csv" : std::filesystem::path(*profile);
+      WriteProfile(report, csv);
+      std::cout << "profile       " << csv.string() << " (and .json)\n";
+    }
   });
 }
 

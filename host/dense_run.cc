@@ -99,7 +99,10 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
     KernelTime& d = sum->kernels[name];
     d.launches += k.launches;
     d.items += k.items;
+    d.ncc_evaluations += k.ncc_evaluations;
+    d.patch_size = k.patch_size;
     d.seconds += k.seconds;
+    d.max_seconds = std::max(d.max_seconds, k.max_seconds);
   }
   sum->gsd = s.gsd;
 }
@@ -136,6 +139,7 @@ RunReport RunDense(const RunOptions& options) {
 
   const Block block = ReadBlock(options.block);
   report.images = static_cast<int>(block.images.size());
+  const BlockGeometry geometry = EstimateBlockGeometry(block);
   GroupingOptions gopt = options.grouping;
   gopt.level = options.matcher.level;
   GroupingPlan plan;
@@ -158,6 +162,7 @@ RunReport RunDense(const RunOptions& options) {
   } else {
     plan = PlanGroups(block, gopt);
     report.strategy = ToString(plan.strategy);
+    for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   }
   end_stage("plan");
 
@@ -168,7 +173,7 @@ RunReport RunDense(const RunOptions& options) {
 
   DeviceOptions device_options;
   device_options.device = options.device;
-  device_options.profile = true;
+  device_options.profile = options.profile;
   ClContext context(device_options);
   report.device = context.device().Describe();
 
@@ -195,7 +200,8 @@ RunReport RunDense(const RunOptions& options) {
       std::fprintf(stderr, "group %d/%d: %zu images\n", g + 1, n, plan.groups[g].images.size());
     }
     const auto t0 = std::chrono::steady_clock::now();
-    MatchResult result = MatchGroup(block, plan.groups[g].images, options.matcher, context);
+    MatchResult result =
+        MatchGroup(block, plan.groups[g].images, options.matcher, context, &geometry);
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
     AddStats(result.stats, &report.stats);
@@ -220,8 +226,8 @@ RunReport RunDense(const RunOptions& options) {
     parts[g].center = plan.groups[g].center + block.origin.head<2>();
   }
   MergeOptions mo;
-  mo.radius = options.merge_radius_gsd * EstimateBlockGeometry(block).gsd_median *
-              std::ldexp(1.0, options.matcher.level);
+  mo.radius =
+      options.merge_radius_gsd * geometry.gsd_median * std::ldexp(1.0, options.matcher.level);
   PointCloud merged = MergeGroupClouds(parts, mo, &report.merge);
   if (merged.crs.empty()) merged.crs = block.crs;
   clouds.clear();
@@ -257,6 +263,11 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
   const MatchStats& s = report.stats;
   out << "device        " << report.device << "\n";
   out << "groups        " << report.groups.size() << " (" << report.strategy << ")\n";
+  if (!report.ungrouped.empty()) {
+    out << "ungrouped     " << report.ungrouped.size() << " images in no group (not matched):";
+    for (const std::string& name : report.ungrouped) out << " " << name;
+    out << "\n";
+  }
   for (const GroupRun& g : report.groups) {
     out << "  group " << std::setw(3) << g.index + 1 << "  " << std::setw(2) << g.images.size()
         << " images  ";

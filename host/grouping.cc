@@ -218,6 +218,7 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
   // Tiles split the extent evenly, so the last ones are not slivers.
   const Eigen::Vector2d tile(size.x() / nx, size.y() / ny);
   std::vector<bool> used(block.images.size(), false);
+  std::vector<int> tiles_in_group;  // per group of plan->groups
   for (int ty = 0; ty < ny; ++ty) {
     for (int tx = 0; tx < nx; ++tx) {
       const Eigen::Vector2d t0 = lo + Eigen::Vector2d(tx * tile.x(), ty * tile.y());
@@ -276,10 +277,30 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
       }
       if (g.images.size() < 2) continue;
       for (const int i : g.images) used[i] = true;
+      // Neighbouring tiles often pick the same images; matching them twice
+      // would only produce the same cloud twice, so they become one group
+      // whose centre is the mean of its tiles' centres.
+      std::vector<int> key_images = g.images;
+      std::sort(key_images.begin(), key_images.end());
+      bool merged = false;
+      for (size_t k = 0; k < plan->groups.size() && !merged; ++k) {
+        std::vector<int> other = plan->groups[k].images;
+        std::sort(other.begin(), other.end());
+        if (other != key_images) continue;
+        ImageGroup& e = plan->groups[k];
+        const double n = static_cast<double>(tiles_in_group[k]);
+        e.center = (e.center * n + center) / (n + 1);
+        e.tile_min = e.tile_min.cwiseMin(t0);
+        e.tile_max = e.tile_max.cwiseMax(t0 + tile);
+        ++tiles_in_group[k];
+        merged = true;
+      }
+      if (merged) continue;
       g.center = center;
       g.tile_min = t0;
       g.tile_max = t0 + tile;
       plan->groups.push_back(std::move(g));
+      tiles_in_group.push_back(1);
     }
   }
   for (size_t i = 0; i < used.size(); ++i)

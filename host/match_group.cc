@@ -19,10 +19,11 @@ double TriangulationAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return std::acos(std::clamp(ra.dot(rb), -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level) {
+MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
+                              const BlockGeometry* known_geometry) {
   MatchGroupData group;
   group.origin = block.origin;
-  const BlockGeometry geometry = EstimateBlockGeometry(block);
+  const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
   std::vector<double> valid_depths;
   for (const int id : ids) {
     if (geometry.images.size() > static_cast<size_t>(id) && geometry.images[id].valid) {

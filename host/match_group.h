@@ -9,6 +9,7 @@
 
 #include "ncc_scorer.h"
 #include "sapmvs/block.h"
+#include "sapmvs/block_geometry.h"
 #include "sapmvs/camera.h"
 
 namespace sapmvs {
@@ -35,7 +36,11 @@ struct MatchGroupData {
 // Loads (undistorted) images `ids` of `block` and reduces them to `level`
 // with 2x2 area averaging, so pixel centres stay where Camera::Scaled puts
 // them. Throws Error naming the image for unreadable files.
-MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level);
+// `geometry`: EstimateBlockGeometry(block) when the caller has it (a
+// whole-block run loads many groups of one block; estimating it reads the
+// block's DEM each time), else nullptr and it is estimated here.
+MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
+                              const BlockGeometry* geometry = nullptr);
 
 // Picks each image's views: images whose footprint overlaps its own at the
 // expected depth and whose line of sight meets its own at >= max_angle_deg,

@@ -105,7 +105,8 @@ bool MatcherOptions::Check() const {
 }
 
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
-                       const MatcherOptions& options, ClContext& context) {
+                       const MatcherOptions& options, ClContext& context,
+                       const BlockGeometry* geometry) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("matcher options: expected " + problem);
   std::vector<int> ids = image_ids;
@@ -128,7 +129,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     stage_start = std::chrono::steady_clock::now();
   };
 
-  MatchGroupData group = LoadMatchGroup(block, ids, options.level);
+  MatchGroupData group = LoadMatchGroup(block, ids, options.level, geometry);
   SelectViews(options, &group);
   stats.images = static_cast<int>(group.images.size());
   stats.gsd = group.gsd;

@@ -64,16 +64,27 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(PatchRefiner& refiner,
   ClEvent event;
   std::vector<RefinedPatch> out = refiner.Refine(patches, views, &event);
   const int size = refiner.options().patch_size;
-  Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size),
-        static_cast<long>(patches.size()), event);
+  double evaluations = 0;
+  for (const auto& v : views) {
+    evaluations += static_cast<double>(v.size()) * (1 + 6 * refiner.options().iterations);
+  }
+  Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size), size,
+        static_cast<long>(patches.size()), evaluations, event);
   return out;
 }
 
-void PatchEngine::Count(const std::string& kernel, long items, const ClEvent& event) {
+void PatchEngine::Count(const std::string& kernel, int patch_size, long items,
+                        double ncc_evaluations, const ClEvent& event) {
   KernelTime& t = kernel_times_[kernel];
   ++t.launches;
   t.items += items;
-  if (event.profiling()) t.seconds += 1e-9 * static_cast<double>(event.DeviceTimeNs());
+  t.ncc_evaluations += ncc_evaluations;
+  t.patch_size = patch_size;
+  if (event.profiling()) {
+    const double seconds = 1e-9 * static_cast<double>(event.DeviceTimeNs());
+    t.seconds += seconds;
+    t.max_seconds = std::max(t.max_seconds, seconds);
+  }
 }
 
 std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& patches,
@@ -81,8 +92,8 @@ std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& p
   if (pairs.empty()) return {};
   ClEvent event;
   std::vector<float> scores = scorers_.at(size)->Score(patches, pairs, &event);
-  Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size),
-        static_cast<long>(pairs.size()), event);
+  Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size), size,
+        static_cast<long>(pairs.size()), static_cast<double>(pairs.size()), event);
   return scores;
 }
 

@@ -72,7 +72,8 @@ class PatchEngine {
                                 int ref, int half) const;
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,
                              const std::vector<NccPair>& pairs);
-  void Count(const std::string& kernel, long items, const ClEvent& event);
+  void Count(const std::string& kernel, int patch_size, long items, double ncc_evaluations,
+             const ClEvent& event);
   std::vector<RefinedPatch> RefineWith(PatchRefiner& refiner, const std::vector<NccPatch>& patches,
                                        const std::vector<std::vector<int>>& views);
 

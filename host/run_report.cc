@@ -88,6 +88,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["dsm_cell"] = report.dsm_cell;
   j["peak_rss_bytes"] = report.peak_rss_bytes;
   j["grouping"] = report.strategy;
+  j["ungrouped"] = report.ungrouped;
   j["matcher"] = MatcherOptionsJson(options.matcher);
   nlohmann::json groups = nlohmann::json::array();
   for (size_t g = 0; g < report.groups.size(); ++g) {

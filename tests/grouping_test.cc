@@ -265,6 +265,24 @@ TEST(GroupingFootprint, EveryGroundPointSeenTwiceIsOwnedByAGroupThatSeesIt) {
   EXPECT_EQ(owner_sees, matchable) << owner_sees << " of " << matchable;
 }
 
+TEST(GroupingFootprint, NoTwoGroupsMatchTheSameImages) {
+  // Tiles that pick the same images are one group: matching the same images
+  // twice only makes the same cloud twice.
+  for (const char* preset : {"small", "campus"}) {
+    const SimBlock s = MakeSimBlock(preset);
+    GroupingOptions o;
+    o.strategy = GroupingStrategy::kFootprint;
+    o.tile_size = 0.5;  // small tiles: neighbours often choose alike
+    const GroupingPlan plan = PlanGroups(s.block, o);
+    std::set<std::vector<int>> sets;
+    for (const ImageGroup& g : plan.groups) {
+      std::vector<int> ids = g.images;
+      std::sort(ids.begin(), ids.end());
+      EXPECT_TRUE(sets.insert(ids).second) << preset << ": images matched twice";
+    }
+  }
+}
+
 TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
   const SimBlock s = MakeSimBlock("campus");
   GroupingOptions o;

@@ -40,6 +40,9 @@ struct RunOptions {
   // ground sample distances of the matched level. > 0.
   double merge_radius_gsd = 1.0;
   DsmOptions dsm;
+  // Profile the device queue (CL_QUEUE_PROFILING_ENABLE): kernel device
+  // times in the report, and the profile tables (run_profile.h).
+  bool profile = false;
 
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
@@ -61,7 +64,8 @@ struct RunReport {
   bool finished = false;  // false: stopped by max_groups, outputs not written
   int images = 0;
   std::vector<GroupRun> groups;
-  MatchStats stats;  // summed over the groups matched in this call
+  std::vector<std::string> ungrouped;  // images the plan put in no group (grouping.h)
+  MatchStats stats;                    // summed over the groups matched in this call
   MergeStats merge;
   long points = 0;
   double mean_spacing = 0;  // mean nearest-neighbour distance, CRS units

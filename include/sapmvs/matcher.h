@@ -15,6 +15,8 @@
 
 namespace sapmvs {
 
+struct BlockGeometry;
+
 class ClContext;
 
 enum class MatchMode { kSapmvs, kPmvs };
@@ -95,8 +97,15 @@ struct StageTime {
 
 struct KernelTime {
   long launches = 0;
-  long items = 0;  // patches or (patch, view) pairs
-  double seconds = 0;
+  long items = 0;  // work items: patches (refinement) or (patch, view) pairs (scoring)
+  // NCC evaluations of one patch in one view pair, each over patch_size^2
+  // samples: one per pair for scoring; for refinement the upper bound
+  // sum over patches of views * (1 + 6 * iterations) (a candidate that
+  // leaves the image stops early).
+  double ncc_evaluations = 0;
+  int patch_size = 0;
+  double seconds = 0;      // device time, summed (0 without queue profiling)
+  double max_seconds = 0;  // of one launch
 };
 
 struct MatchStats {
@@ -126,9 +135,11 @@ struct MatchResult {
   MatchStats stats;
 };
 
-// Matches images `image_ids` of `block` (all when empty). Throws Error for
+// Matches images `image_ids` of `block` (all when empty). `geometry`:
+// EstimateBlockGeometry(block) when the caller already has it, else nullptr. Throws Error for
 // bad options, unreadable images or fewer than 2 usable images.
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
-                       const MatcherOptions& options, ClContext& context);
+                       const MatcherOptions& options, ClContext& context,
+                       const BlockGeometry* geometry = nullptr);
 
 }  // namespace sapmvs
