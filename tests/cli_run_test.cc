@@ -171,6 +171,29 @@ TEST_F(CliRunTest, NegativeLevelIsOneLineNamingIt) {
   EXPECT_TRUE(NoOutput());
 }
 
+TEST_F(CliRunTest, ProfilePrintsKernelTablesAndWritesThem) {
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " --profile -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("profile: kernels"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("patch_refine"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("profile: phases"), std::string::npos) << r.out;
+  ASSERT_TRUE(fs::exists(out_ / "profile.csv"));
+  std::ifstream in(out_ / "profile.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  double device = 0;
+  for (const auto& k : j.at("kernels")) device += k.at("seconds").get<double>();
+  EXPECT_GT(device, 0) << "the queue did not profile";
+  // Without --profile the queue does not profile: no device times at all.
+  const fs::path plain = out_ / "plain";
+  const auto p = RunCli("run " + Block().string() + " --out " + plain.string() + " -q");
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  std::ifstream rin(plain / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(rin);
+  for (const auto& k : report.at("kernels")) EXPECT_EQ(k.at("device_seconds").get<double>(), 0);
+  EXPECT_FALSE(fs::exists(plain / "profile.csv"));
+}
+
 // Whole-block runs: the tiny block (2 strips of 2 images) split into one
 // group per strip by --max-images 3, matched with min_image_num 2.
 class CliBlockRunTest : public CliRunTest {
