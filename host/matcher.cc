@@ -155,16 +155,23 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   stats.seeds_accepted = propagator.seeds_accepted();
   end_stage("seeds");
 
-  if (options.mode == MatchMode::kSapmvs && options.use_edges) {
+  // Per image, the depths its accepted seeds span (5th to 95th percentile),
+  // padded by `share` of that span plus `gsds` ground sample distances;
+  // (0, 0) when an image has fewer than 10 seeds.
+  auto seed_depth_ranges = [&](double share, double gsds) {
     std::vector<std::pair<double, double>> ranges(group.images.size(), {0.0, 0.0});
     for (size_t i = 0; i < group.images.size(); ++i) {
       std::vector<double> d = propagator.seed_depths()[i];
       if (d.size() < 10) continue;
       std::sort(d.begin(), d.end());
       const double lo = d[d.size() / 20], hi = d[d.size() - 1 - d.size() / 20];
-      const double pad = 0.25 * (hi - lo) + 2.0 * group.gsd;
+      const double pad = share * (hi - lo) + gsds * group.gsd;
       ranges[i] = {lo - pad, hi + pad};
     }
+    return ranges;
+  };
+  if (options.mode == MatchMode::kSapmvs && options.use_edges) {
+    const auto ranges = seed_depth_ranges(0.25, 2.0);
     EdgeMatchStats es;
     propagator.SetEdges(MatchEdges(group, options, ranges, engine, &es));
     stats.edge_points = es.edge_pixels;
@@ -189,7 +196,33 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   const auto& points = propagator.points();
   const auto& patches = propagator.patches();
   stats.points_before_filter = static_cast<long>(points.size());
-  const std::vector<bool> keep = FilterPoints(group, options, points, patches, &stats);
+  std::vector<bool> keep = FilterPoints(group, options, points, patches, &stats);
+  // Gross errors: a point whose depth in its reference image is a far-out
+  // value of that image's seed depths (Tukey's fences, 3 interquartile ranges
+  // beyond the quartiles, plus 10 GSD) is a false match that grew into a
+  // cluster big enough to pass the cluster filter (on the NGI block, clusters
+  // kilometres below the ground). Quartiles, not the seeds' extremes: false
+  // seeds are among them.
+  std::vector<std::pair<double, double>> plausible(group.images.size(), {0.0, 0.0});
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    std::vector<double> d = propagator.seed_depths()[i];
+    if (d.size() < 10) continue;
+    std::sort(d.begin(), d.end());
+    const double q1 = d[d.size() / 4], q3 = d[(3 * d.size()) / 4];
+    const double pad = 3.0 * (q3 - q1) + 10.0 * group.gsd;
+    plausible[i] = {q1 - pad, q3 + pad};
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!keep[i]) continue;
+    const int ref = patches[points[i].patch].ref;
+    const auto [lo, hi] = plausible[ref];
+    if (lo == 0 && hi == 0) continue;
+    const double depth = group.images[ref].camera.Depth(points[i].x);
+    if (depth < lo || depth > hi) {
+      keep[i] = false;
+      ++stats.removed_depth_range;
+    }
+  }
   end_stage("filter");
 
   PointCloud& cloud = result.cloud;

@@ -51,6 +51,7 @@ nlohmann::json MatchStatsJson(const MatchStats& s) {
                  {"removed_visibility", s.removed_visibility},
                  {"removed_neighbourhood", s.removed_neighbourhood},
                  {"removed_clusters", s.removed_clusters},
+                 {"removed_depth_range", s.removed_depth_range},
                  {"points", s.points}};
   nlohmann::json stages = nlohmann::json::array();
   for (const auto& [name, t] : s.stages) {

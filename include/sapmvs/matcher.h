@@ -124,6 +124,7 @@ struct MatchStats {
   long removed_visibility = 0;
   long removed_neighbourhood = 0;
   long removed_clusters = 0;
+  long removed_depth_range = 0;  // far outside the depths the image's seeds span
   long points = 0;
   std::vector<std::pair<std::string, StageTime>> stages;  // in order
   std::map<std::string, KernelTime> kernels;
