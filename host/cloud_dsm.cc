@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -218,15 +219,12 @@ void WriteReliefPng(const std::filesystem::path& path, const GeoRaster& dsm) {
   }
   std::vector<uint8_t> bytes;
   if (!cv::imencode(".png", colour, bytes)) throw Error(path.string() + ": PNG encoding failed");
-  AtomicFile file(path);
-  {
-    FILE* f = std::fopen(file.temp_path().c_str(), "wb");
-    if (!f) throw Error(path.string() + ": cannot write");
-    const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), f);
-    if (std::fclose(f) != 0 || written != bytes.size())
-      throw Error(path.string() + ": write failed");
-  }
-  file.Commit();
+  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+    if (!f) throw Error(path.string() + ": write failed");
+  });
 }
 
 }  // namespace sapmvs

@@ -20,12 +20,11 @@ std::string MergeOptions::Problem() const {
   return "";
 }
 
-int CoreOwner(const std::vector<GroupCloud>& groups, double x, double y) {
+int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
   int best = -1;
   double best_d2 = 0;
-  for (size_t g = 0; g < groups.size(); ++g) {
-    const double dx = x - groups[g].center.x(), dy = y - groups[g].center.y();
-    const double d2 = dx * dx + dy * dy;
+  for (size_t g = 0; g < centers.size(); ++g) {
+    const double d2 = (Eigen::Vector2d(x, y) - centers[g]).squaredNorm();
     if (best < 0 || d2 < best_d2) {
       best = static_cast<int>(g);
       best_d2 = d2;
@@ -44,6 +43,49 @@ struct CellHash {
   size_t operator()(const CellKey& k) const {
     return static_cast<size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
   }
+};
+
+// Points hashed into cubes of side `radius`, so that everything within the
+// radius of a point lies in its cube or the 26 around it.
+template <typename Ref>
+class RadiusGrid {
+ public:
+  explicit RadiusGrid(double radius) : r_(radius) {}
+  void Insert(const Eigen::Vector3d& p, const Ref& ref) { cells_[Key(p)].push_back(ref); }
+  // True as soon as `hit(ref)` holds for an inserted ref in a neighbouring cube.
+  template <typename Hit>
+  bool AnyNear(const Eigen::Vector3d& p, const Hit& hit) const {
+    const CellKey k = Key(p);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(CellKey{k.x + dx, k.y + dy, k.z + dz});
+          if (it == cells_.end()) continue;
+          for (const Ref& ref : it->second) {
+            if (hit(ref)) return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+  // Calls `visit(ref)` for every inserted ref in a neighbouring cube.
+  template <typename Visit>
+  void ForEachNear(const Eigen::Vector3d& p, const Visit& visit) const {
+    AnyNear(p, [&](const Ref& ref) {
+      visit(ref);
+      return false;
+    });
+  }
+
+ private:
+  CellKey Key(const Eigen::Vector3d& p) const {
+    return CellKey{static_cast<int64_t>(std::floor(p.x() / r_)),
+                   static_cast<int64_t>(std::floor(p.y() / r_)),
+                   static_cast<int64_t>(std::floor(p.z() / r_))};
+  }
+  double r_;
+  std::unordered_map<CellKey, std::vector<Ref>, CellHash> cells_;
 };
 
 struct Ref {
@@ -74,6 +116,8 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
   out.has_scores = first.has_scores;
   out.has_views = first.has_views;
 
+  std::vector<Eigen::Vector2d> centers;
+  for (const GroupCloud& g : groups) centers.push_back(g.center);
   struct Item {
     Ref ref;
     bool core;
@@ -85,7 +129,7 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
     st.input += static_cast<long>(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) {
       const bool core =
-          CoreOwner(groups, pts[i].position.x(), pts[i].position.y()) == static_cast<int>(g);
+          CoreOwner(centers, pts[i].position.x(), pts[i].position.y()) == static_cast<int>(g);
       items.push_back({{static_cast<int>(g), i}, core, pts[i].score});
     }
   }
@@ -95,41 +139,22 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
     return a.score > b.score;
   });
 
-  const double r = options.radius;
-  const double r2 = r * r;
+  const double r2 = options.radius * options.radius;
   auto point = [&](const Ref& ref) -> const CloudPoint& {
     return groups[ref.group].cloud->points[ref.index];
   };
-  auto key = [&](const Eigen::Vector3d& p) {
-    return CellKey{static_cast<int64_t>(std::floor(p.x() / r)),
-                   static_cast<int64_t>(std::floor(p.y() / r)),
-                   static_cast<int64_t>(std::floor(p.z() / r))};
-  };
-  std::unordered_map<CellKey, std::vector<Ref>, CellHash> kept;
+  RadiusGrid<Ref> kept(options.radius);
   std::vector<Ref> order;
   for (const Item& item : items) {
     const Eigen::Vector3d& p = point(item.ref).position;
-    const CellKey k = key(p);
-    bool duplicate = false;
-    for (int dx = -1; dx <= 1 && !duplicate; ++dx) {
-      for (int dy = -1; dy <= 1 && !duplicate; ++dy) {
-        for (int dz = -1; dz <= 1 && !duplicate; ++dz) {
-          const auto it = kept.find(CellKey{k.x + dx, k.y + dy, k.z + dz});
-          if (it == kept.end()) continue;
-          for (const Ref& other : it->second) {
-            if (other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2) {
-              duplicate = true;
-              break;
-            }
-          }
-        }
-      }
-    }
+    const bool duplicate = kept.AnyNear(p, [&](const Ref& other) {
+      return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
+    });
     if (duplicate) {
       ++st.duplicates;
       continue;
     }
-    kept[k].push_back(item.ref);
+    kept.Insert(p, item.ref);
     order.push_back(item.ref);
     ++st.kept_by_group[item.ref.group];
     if (item.core) ++st.core_by_group[item.ref.group];
@@ -143,6 +168,29 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
   for (const Ref& ref : order) out.points.push_back(point(ref));
   st.kept = static_cast<long>(out.points.size());
   return out;
+}
+
+long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of,
+                          double radius) {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    throw Error("cross-group pairs: expected a radius > 0");
+  }
+  if (group_of.size() != cloud.points.size()) {
+    throw Error("cross-group pairs: expected one group per point (" +
+                std::to_string(group_of.size()) + " for " + std::to_string(cloud.points.size()) +
+                " points)");
+  }
+  RadiusGrid<size_t> grid(radius);
+  for (size_t i = 0; i < cloud.points.size(); ++i) grid.Insert(cloud.points[i].position, i);
+  long pairs = 0;
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    const Eigen::Vector3d& p = cloud.points[i].position;
+    grid.ForEachNear(p, [&](size_t j) {
+      pairs +=
+          j > i && group_of[j] != group_of[i] && (cloud.points[j].position - p).norm() <= radius;
+    });
+  }
+  return pairs;
 }
 
 }  // namespace sapmvs

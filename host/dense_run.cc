@@ -144,24 +144,23 @@ RunReport RunDense(const RunOptions& options) {
   GroupingOptions gopt = options.grouping;
   gopt.level = options.matcher.level;
   GroupingPlan plan;
-  std::vector<int> every(block.images.size());
-  std::iota(every.begin(), every.end(), 0);
+  ImageGroup all;
+  all.images.resize(block.images.size());
+  std::iota(all.images.begin(), all.images.end(), 0);
+  all.memory = EstimateGroupMemory(block, all.images, options.matcher);
   if (static_cast<int>(block.images.size()) <= gopt.max_images &&
-      EstimateGroupMemory(block, every, options.matcher).Total() <= gopt.memory_budget) {
+      all.memory.Total() <= gopt.memory_budget) {
     // Small enough for one group: splitting would only lose views.
-    ImageGroup all;
     Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (size_t i = 0; i < block.images.size(); ++i) {
-      all.images.push_back(static_cast<int>(i));
-      sum += block.images[i].camera.center().head<2>() - block.origin.head<2>();
+    for (const BlockImage& im : block.images) {
+      sum += im.camera.center().head<2>() - block.origin.head<2>();
     }
     all.center = sum / std::max<size_t>(1, block.images.size());
-    all.memory = EstimateGroupMemory(block, all.images, options.matcher);
     plan.strategy = gopt.strategy;
     plan.groups.push_back(all);
     report.strategy = "single group";
   } else {
-    plan = PlanGroups(block, gopt);
+    plan = PlanGroups(block, gopt, &geometry);
     report.strategy = ToString(plan.strategy);
     for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   }
@@ -181,6 +180,7 @@ RunReport RunDense(const RunOptions& options) {
   const bool show = options.matcher.progress && Progress::TerminalAllowsProgress();
   const int n = static_cast<int>(plan.groups.size());
   int matched_now = 0;
+  bool stopped = false;  // groups left for a later call (max_groups)
   for (int g = 0; g < n; ++g) {
     GroupRun run;
     run.index = g;
@@ -194,6 +194,7 @@ RunReport RunDense(const RunOptions& options) {
       continue;
     }
     if (options.max_groups > 0 && matched_now >= options.max_groups) {
+      stopped = true;
       report.groups.push_back(run);
       continue;
     }
@@ -211,11 +212,10 @@ RunReport RunDense(const RunOptions& options) {
     report.groups.push_back(run);
   }
   end_stage("match");
-  for (int g = 0; g < n; ++g) {
-    if (checkpoints.Done(g)) continue;
+  if (stopped) {
     report.total_seconds = Since(start);
     report.peak_rss_bytes = PeakRssBytes();
-    return report;  // stopped by max_groups: resumable
+    return report;  // resumable
   }
 
   // Merge from the checkpoints, fresh or resumed alike.

@@ -394,7 +394,8 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
   return m;
 }
 
-GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options) {
+GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
+                        const BlockGeometry* known_geometry) {
   if (const std::string problem = options.Problem(); !problem.empty())
     throw Error("grouping options: expected " + problem);
   if (block.images.size() < 2) {
@@ -406,7 +407,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options) {
   plan.strategy = options.strategy;
   plan.options = options;
   plan.strips = DetectStrips(block);
-  const BlockGeometry geometry = EstimateBlockGeometry(block);
+  const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
   const std::vector<Footprint> fp = Footprints(block, geometry);
   if (options.strategy == GroupingStrategy::kStrip)
     PlanStrips(block, options, fp, &plan);

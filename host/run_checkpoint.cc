@@ -2,24 +2,14 @@
 
 #include <cstdio>
 #include <fstream>
-#include <iomanip>
 #include <nlohmann/json.hpp>
 
 #include "run_report.h"
-#include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 
 namespace sapmvs {
 
 namespace {
-
-void WriteJson(const std::filesystem::path& path, const nlohmann::json& j) {
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp);
-    f << std::setw(2) << j << "\n";
-    if (!f) throw Error(path.string() + ": write failed");
-  });
-}
 
 nlohmann::json ReadJson(const std::filesystem::path& path) {
   std::ifstream f(path);
@@ -62,7 +52,7 @@ RunCheckpoints::RunCheckpoints(std::filesystem::path dir, const Block& block,
                   "to resume (give --restart to discard it)");
     }
   } else {
-    WriteJson(plan_path, record);
+    WriteJsonFile(plan_path, record);
   }
 }
 
@@ -101,7 +91,7 @@ void RunCheckpoints::Write(int group, const PointCloud& cloud, double seconds,
   j["group"] = group + 1;
   j["points"] = static_cast<long>(cloud.points.size());
   j["seconds"] = seconds;
-  WriteJson(StatusPath(group), j);
+  WriteJsonFile(StatusPath(group), j);
 }
 
 }  // namespace sapmvs

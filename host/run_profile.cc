@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "run_report.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 
@@ -142,11 +143,7 @@ void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
   }
   std::filesystem::path json_path = csv;
   json_path.replace_extension(".json");
-  WriteFileAtomically(json_path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp);
-    f << std::setw(2) << j << "\n";
-    if (!f) throw Error(json_path.string() + ": write failed");
-  });
+  WriteJsonFile(json_path, j);
 }
 
 }  // namespace sapmvs

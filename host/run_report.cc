@@ -8,6 +8,14 @@
 
 namespace sapmvs {
 
+void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
+  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << std::setw(2) << j << "\n";
+    if (!f) throw Error(path.string() + ": write failed");
+  });
+}
+
 nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
   return {{"mode", ToString(m.mode)},
           {"level", m.level},
@@ -125,12 +133,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   matching.erase("stages");
   matching.erase("kernels");
   j["matching"] = matching;
-  const std::filesystem::path path = options.out / "report.json";
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp);
-    f << std::setw(2) << j << "\n";
-    if (!f) throw Error(path.string() + ": write failed");
-  });
+  WriteJsonFile(options.out / "report.json", j);
 }
 
 }  // namespace sapmvs

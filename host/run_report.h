@@ -1,5 +1,6 @@
 #pragma once
 // DIR/report.json of `sapmvs run`, and the JSON pieces the checkpoints share.
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "sapmvs/block.h"
@@ -9,6 +10,8 @@
 
 namespace sapmvs {
 
+// Writes `j` (indented) to `path` atomically; throws Error naming the path.
+void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j);
 // Every field of the options: what a checkpoint must agree on to be reused.
 nlohmann::json MatcherOptionsJson(const MatcherOptions& m);
 // Counts, per-stage wall/device times and kernel times of one or more groups.

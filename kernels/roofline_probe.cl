@@ -27,7 +27,39 @@
 #define NCC_MIN_VARIANCE 1e-4f
 #endif
 
-#define PROBE_SAMPLES (PATCH_SIZE * PATCH_SIZE)
+#define NCC_NUM_SAMPLES (PATCH_SIZE * PATCH_SIZE)
+
+// Copied verbatim from ncc_score.cl (no #include in the kernel embedding;
+// tests/roofline_probe_test.cc compares the text), so that the probe does the
+// scoring kernel's NCC arithmetic exactly.
+// The NCC of `a` and `b` (NCC_NUM_SAMPLES values each), two-pass so that
+// bright images do not lose the variance to cancellation; NaN when either
+// per-sample variance is below NCC_MIN_VARIANCE.
+float ncc_of(const float* a, const float* b) {
+  float mean_a = 0.0f;
+  float mean_b = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    mean_a += a[k];
+    mean_b += b[k];
+  }
+  mean_a /= (float)NCC_NUM_SAMPLES;
+  mean_b /= (float)NCC_NUM_SAMPLES;
+  float saa = 0.0f;
+  float sbb = 0.0f;
+  float sab = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    const float da = a[k] - mean_a;
+    const float db = b[k] - mean_b;
+    saa += da * da;
+    sbb += db * db;
+    sab += da * db;
+  }
+  const float min_sum = NCC_MIN_VARIANCE * (float)NCC_NUM_SAMPLES;
+  if (!(saa >= min_sum && sbb >= min_sum)) {
+    return NAN;
+  }
+  return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+}
 
 __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void copy_float4(
     __global const float4* restrict src, __global float4* restrict dst, const int n) {
@@ -52,36 +84,15 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_w
     scores[i] = NAN;
     return;
   }
-  float va[PROBE_SAMPLES];
-  float vb[PROBE_SAMPLES];
-  float mean_a = 0.0f;
-  float mean_b = 0.0f;
+  float va[NCC_NUM_SAMPLES];
+  float vb[NCC_NUM_SAMPLES];
   for (int r = 0; r < PATCH_SIZE; ++r) {
     __global const float* row_a = a + (size_t)(c.y + r) * (size_t)width + c.x;
     __global const float* row_b = b + (size_t)(c.w + r) * (size_t)width + c.z;
     for (int k = 0; k < PATCH_SIZE; ++k) {
       va[r * PATCH_SIZE + k] = row_a[k];
       vb[r * PATCH_SIZE + k] = row_b[k];
-      mean_a += row_a[k];
-      mean_b += row_b[k];
     }
   }
-  mean_a /= (float)PROBE_SAMPLES;
-  mean_b /= (float)PROBE_SAMPLES;
-  float saa = 0.0f;
-  float sbb = 0.0f;
-  float sab = 0.0f;
-  for (int k = 0; k < PROBE_SAMPLES; ++k) {
-    const float da = va[k] - mean_a;
-    const float db = vb[k] - mean_b;
-    saa += da * da;
-    sbb += db * db;
-    sab += da * db;
-  }
-  const float min_sum = NCC_MIN_VARIANCE * (float)PROBE_SAMPLES;
-  if (!(saa >= min_sum && sbb >= min_sum)) {
-    scores[i] = NAN;
-    return;
-  }
-  scores[i] = clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+  scores[i] = ncc_of(va, vb);
 }

@@ -13,11 +13,12 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
-#include <unordered_map>
 
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
+#include "sapmvs/cloud_merge.h"
 #include "sapmvs/error.h"
 #include "sapmvs/ply_io.h"
 #include "sapmvs/raster_io.h"
@@ -31,10 +32,7 @@ namespace {
 // centre: the smallest distance to a bisector with another centre.
 double DistanceToCoreBoundary(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
   const Eigen::Vector2d p(x, y);
-  size_t own = 0;
-  for (size_t g = 1; g < centers.size(); ++g) {
-    if ((p - centers[g]).squaredNorm() < (p - centers[own]).squaredNorm()) own = g;
-  }
+  const size_t own = static_cast<size_t>(CoreOwner(centers, x, y));
   double best = std::numeric_limits<double>::infinity();
   for (size_t g = 0; g < centers.size(); ++g) {
     if (g == own) continue;
@@ -45,40 +43,19 @@ double DistanceToCoreBoundary(const std::vector<Eigen::Vector2d>& centers, doubl
   return best;
 }
 
-long CrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of, double r) {
-  struct Key {
-    long long x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct Hash {
-    size_t operator()(const Key& k) const {
-      return static_cast<size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
-    }
-  };
-  std::unordered_map<Key, std::vector<size_t>, Hash> grid;
-  auto key = [&](const Eigen::Vector3d& p) {
-    return Key{static_cast<long long>(std::floor(p.x() / r)),
-               static_cast<long long>(std::floor(p.y() / r)),
-               static_cast<long long>(std::floor(p.z() / r))};
-  };
-  for (size_t i = 0; i < cloud.points.size(); ++i) grid[key(cloud.points[i].position)].push_back(i);
-  long pairs = 0;
-  for (size_t i = 0; i < cloud.points.size(); ++i) {
-    const Eigen::Vector3d& p = cloud.points[i].position;
-    const Key k = key(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = grid.find(Key{k.x + dx, k.y + dy, k.z + dz});
-          if (it == grid.end()) continue;
-          for (const size_t j : it->second) {
-            if (j > i && group_of[j] != group_of[i] && (cloud.points[j].position - p).norm() <= r) {
-              ++pairs;
-            }
-          }
-        }
+// The group centres a run's report.json lists.
+std::vector<Eigen::Vector2d> ReportCenters(const nlohmann::json& report) {
+  std::vector<Eigen::Vector2d> centers;
+  for (const auto& g : report.at("groups")) {
+    centers.emplace_back(g.at("center")[0].get<double>(), g.at("center")[1].get<double>());
   }
-  return pairs;
+  return centers;
+}
+
+nlohmann::json ReadReport(const std::filesystem::path& dir) {
+  std::ifstream f(dir / "report.json");
+  if (!f) throw Error((dir / "report.json").string() + ": cannot read");
+  return nlohmann::json::parse(f);
 }
 
 }  // namespace
@@ -101,26 +78,15 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const std::filesystem::path dir(run_dir);
-    std::ifstream f(dir / "report.json");
-    if (!f) throw Error((dir / "report.json").string() + ": cannot read");
-    const nlohmann::json report = nlohmann::json::parse(f);
-    std::vector<Eigen::Vector2d> centers;
+    const nlohmann::json report = ReadReport(dir);
     std::vector<int> group_of;
     for (const auto& g : report.at("groups")) {
-      centers.emplace_back(g.at("center")[0].get<double>(), g.at("center")[1].get<double>());
       const long kept = g.at("kept_after_merge").get<long>();
-      group_of.insert(group_of.end(), kept, static_cast<int>(centers.size()) - 1);
+      group_of.insert(group_of.end(), kept, g.at("group").get<int>() - 1);
     }
+    const std::vector<Eigen::Vector2d> centers =
+        ReportCenters(zones_dir.empty() ? report : ReadReport(zones_dir));
     const PointCloud cloud = ReadPly(dir / "cloud.ply");
-    if (!zones_dir.empty()) {
-      std::ifstream z(std::filesystem::path(zones_dir) / "report.json");
-      if (!z) throw Error(zones_dir + "/report.json: cannot read");
-      centers.clear();
-      const nlohmann::json zones = nlohmann::json::parse(z);
-      for (const auto& g : zones.at("groups")) {
-        centers.emplace_back(g.at("center")[0].get<double>(), g.at("center")[1].get<double>());
-      }
-    }
     if (group_of.size() != cloud.points.size()) {
       throw Error("report.json's kept_after_merge counts do not add up to cloud.ply's points");
     }
@@ -150,7 +116,7 @@ int main(int argc, char** argv) {
       std::cout.unsetf(std::ios::floatfield);
     }
     std::cout << std::setprecision(6) << "cross-group pairs within " << duplicate_gsd
-              << " GSD: " << CrossGroupPairs(cloud, group_of, duplicate_gsd * gsd) << "\n";
+              << " GSD: " << CountCrossGroupPairs(cloud, group_of, duplicate_gsd * gsd) << "\n";
   } catch (const std::exception& e) {
     std::cerr << e.what() << "\n";
     return 1;

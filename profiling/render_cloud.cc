@@ -76,7 +76,10 @@ int main(int argc, char** argv) {
     const double zlo = zs[zs.size() / 50], zhi = std::max(zlo + 1e-9, zs[zs.size() * 49 / 50]);
     cv::Mat depth(h, w, CV_64F, cv::Scalar(std::numeric_limits<double>::infinity()));
     cv::Mat picture(h, w, CV_8UC3, cv::Scalar(255, 255, 255));
-    cv::Mat grey(1, 1, CV_8UC1), colour;
+    // The colour scale once, as a 256-entry table.
+    cv::Mat ramp(1, 256, CV_8UC1), colours;
+    for (int k = 0; k < 256; ++k) ramp.at<uint8_t>(0, k) = static_cast<uint8_t>(k);
+    cv::applyColorMap(ramp, colours, cv::COLORMAP_TURBO);
     for (size_t i = 0; i < uvz.size(); ++i) {
       const Eigen::Vector3d& q = uvz[i];
       if (!(q.z() > -1e300) || !std::isfinite(q.x()) || !std::isfinite(q.y())) continue;
@@ -84,10 +87,9 @@ int main(int argc, char** argv) {
       cv::Vec3b c;
       const CloudPoint& p = cloud.points[i];
       if (height_colours || !cloud.has_colors) {
-        grey.at<uint8_t>(0, 0) = static_cast<uint8_t>(
-            std::clamp((p.position.z() - zlo) / (zhi - zlo), 0.0, 1.0) * 255.0 + 0.5);
-        cv::applyColorMap(grey, colour, cv::COLORMAP_TURBO);
-        c = colour.at<cv::Vec3b>(0, 0);
+        c = colours.at<cv::Vec3b>(
+            0, static_cast<int>(std::clamp((p.position.z() - zlo) / (zhi - zlo), 0.0, 1.0) * 255.0 +
+                                0.5));
       } else {
         c = cv::Vec3b(p.color[2], p.color[1], p.color[0]);
       }

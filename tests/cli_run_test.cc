@@ -5,15 +5,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
-#include <tuple>
 
 #include "cl_runtime.h"
 #include "cli_test_util.h"
+#include "sapmvs/cloud_merge.h"
 #include "sapmvs/error.h"
 #include "sapmvs/ply_io.h"
 #include "sapmvs/simulate.h"
@@ -274,29 +273,7 @@ TEST_F(CliBlockRunTest, MergedCloudHasNoCrossGroupDuplicates) {
   EXPECT_GT(j.at("merge").at("cross_group_duplicates").get<long>(), 0);
   // No two points of different groups within 0.25 GSD (the tiny block's GSD
   // is 0.2727 m at full resolution).
-  const double r25 = 0.25 * 0.2727;
-  std::map<std::tuple<long, long, long>, std::vector<size_t>> grid;
-  auto key = [&](const Eigen::Vector3d& p) {
-    return std::make_tuple(static_cast<long>(std::floor(p.x() / r25)),
-                           static_cast<long>(std::floor(p.y() / r25)),
-                           static_cast<long>(std::floor(p.z() / r25)));
-  };
-  for (size_t i = 0; i < cloud.points.size(); ++i) grid[key(cloud.points[i].position)].push_back(i);
-  long pairs = 0;
-  for (size_t i = 0; i < cloud.points.size(); ++i) {
-    const auto [x, y, z] = key(cloud.points[i].position);
-    for (long dx = -1; dx <= 1; ++dx)
-      for (long dy = -1; dy <= 1; ++dy)
-        for (long dz = -1; dz <= 1; ++dz) {
-          const auto it = grid.find({x + dx, y + dy, z + dz});
-          if (it == grid.end()) continue;
-          for (const size_t k : it->second) {
-            pairs += group_of[k] != group_of[i] &&
-                     (cloud.points[k].position - cloud.points[i].position).norm() <= r25;
-          }
-        }
-  }
-  EXPECT_EQ(pairs, 0);
+  EXPECT_EQ(CountCrossGroupPairs(cloud, group_of, 0.25 * 0.2727), 0);
   // The paper's statistics are in the report.
   EXPECT_GT(j.at("mean_point_spacing").get<double>(), 0);
   EXPECT_GT(j.at("density_per_unit2").get<double>(), 0);

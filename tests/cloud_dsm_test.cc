@@ -79,7 +79,7 @@ TEST(CloudDsm, SmallGapsAreFilledLargeHolesStayNodata) {
     // Points on cell edges belong to the cell below them; removing x, y in
     // {10, 10.5, 11} empties exactly the cell around (10.5, 10.5).
     const bool small_gap = x >= 9.9 && x < 11.1 && y >= 9.9 && y < 11.1;
-    const bool big_hole = x >= 25 && x < 40 && y >= 25 && y < 40;   // 15 m
+    const bool big_hole = x >= 25 && x < 40 && y >= 25 && y < 40;  // 15 m
     if (!small_gap && !big_hole) kept.push_back(p);
   }
   c.points = kept;

@@ -163,11 +163,34 @@ TEST(CloudMerge, BadRadiusIsAnError) {
 }
 
 TEST(CloudMerge, CoreOwnerIsTheNearestCentre) {
-  PointCloud a;
-  std::vector<GroupCloud> groups = {{&a, {0, 0}}, {&a, {10, 0}}, {&a, {0, 10}}};
-  EXPECT_EQ(CoreOwner(groups, 1, 1), 0);
-  EXPECT_EQ(CoreOwner(groups, 9, 1), 1);
-  EXPECT_EQ(CoreOwner(groups, 1, 9), 2);
+  const std::vector<Eigen::Vector2d> centers = {{0, 0}, {10, 0}, {0, 10}};
+  EXPECT_EQ(CoreOwner(centers, 1, 1), 0);
+  EXPECT_EQ(CoreOwner(centers, 9, 1), 1);
+  EXPECT_EQ(CoreOwner(centers, 1, 9), 2);
+  EXPECT_EQ(CoreOwner({}, 1, 9), -1);
+}
+
+TEST(CloudMerge, CrossGroupPairsCountAsByBruteForce) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 4);
+  PointCloud c;
+  std::vector<int> group_of;
+  for (int i = 0; i < 601; ++i) {
+    CloudPoint p;
+    p.position = {500000.0 + u(rng), 5400000.0 + u(rng), 0.25 * u(rng)};
+    c.points.push_back(p);
+    group_of.push_back(i % 3);
+  }
+  for (const double r : {0.05, 0.2, 0.5}) {
+    const long fast = CountCrossGroupPairs(c, group_of, r);
+    EXPECT_EQ(fast, CrossGroupPairsWithin(c, group_of, r)) << r;
+    if (r == 0.5) {
+      EXPECT_GT(fast, 0);
+    }
+  }
+  EXPECT_THROW(CountCrossGroupPairs(c, group_of, 0.0), Error);
+  group_of.pop_back();
+  EXPECT_THROW(CountCrossGroupPairs(c, group_of, 0.1), Error);
 }
 
 }  // namespace

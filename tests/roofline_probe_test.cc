@@ -5,6 +5,7 @@
 #include <random>
 
 #include "cl_test_fixture.h"
+#include "kernel_source.h"
 #include "sapmvs/error.h"
 #include "test_util.h"
 
@@ -43,10 +44,10 @@ TEST_F(RooflineProbeTest, NccWindowsMatchTheDoubleReference) {
     std::uniform_int_distribution<int> x(-2, kWidth - mu + 2), y(-2, kHeight - mu + 2);
     std::vector<cl_int4> corners;
     for (int i = 0; i < 997; ++i) corners.push_back({{x(rng), y(rng), x(rng), y(rng)}});
-    corners.push_back({{0, 0, 0, 0}});                       // flat in a: NaN
+    corners.push_back({{0, 0, 0, 0}});                         // flat in a: NaN
     corners.push_back({{kWidth - mu, kHeight - mu, 20, 10}});  // last valid corner
-    corners.push_back({{kWidth - mu + 1, 0, 0, 0}});         // one past: NaN
-    corners.push_back({{12, 5, 10, 5}});                     // b = a shifted by 2
+    corners.push_back({{kWidth - mu + 1, 0, 0, 0}});           // one past: NaN
+    corners.push_back({{12, 5, 10, 5}});                       // b = a shifted by 2
     const std::vector<float> got = probe.NccWindows(va, vb, corners);
     ASSERT_EQ(got.size(), corners.size());
     long valid = 0;
@@ -79,6 +80,19 @@ TEST_F(RooflineProbeTest, CopyCopiesOddCountsExactly) {
     for (int k = 0; k < 4; ++k) ASSERT_EQ(out[i].s[k], src[i].s[k]) << i;
   for (int i = n; i < n + 3; ++i) EXPECT_EQ(out[i].s[0], -7.0f);  // nothing past n
   EXPECT_THROW(probe.Copy(s, d, n + 1), Error);
+}
+
+TEST(RooflineProbeKernelText, NccIsAVerbatimCopyOfTheScoringKernels) {
+  const std::string ncc = EmbeddedKernelSource("ncc_score.cl");
+  const std::string probe = EmbeddedKernelSource("roofline_probe.cl");
+  const std::string begin = "// The NCC of `a` and `b`";
+  const size_t a0 = ncc.find(begin), b0 = probe.find(begin);
+  ASSERT_NE(a0, std::string::npos);
+  ASSERT_NE(b0, std::string::npos);
+  const size_t a1 = ncc.find("\n}\n", a0), b1 = probe.find("\n}\n", b0);
+  ASSERT_NE(a1, std::string::npos);
+  ASSERT_NE(b1, std::string::npos);
+  EXPECT_EQ(ncc.substr(a0, a1 - a0), probe.substr(b0, b1 - b0));
 }
 
 TEST(RooflineProbeOptions, BadOptionsNameTheValue) {

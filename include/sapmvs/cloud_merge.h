@@ -45,7 +45,11 @@ struct MergeStats {
 PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOptions& options,
                             MergeStats* stats = nullptr);
 
-// The index of the group whose centre is nearest to (x, y): the core owner.
-int CoreOwner(const std::vector<GroupCloud>& groups, double x, double y);
+// The index of the centre nearest to (x, y): the core owner; -1 for none.
+int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);
+
+// Pairs of points of different groups (group_of[i] is point i's group) within
+// `radius` of each other (3D): what the merge leaves none of. radius > 0.
+long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of, double radius);
 
 }  // namespace sapmvs

@@ -22,6 +22,7 @@
 namespace sapmvs {
 
 struct MatcherOptions;
+struct BlockGeometry;
 
 enum class GroupingStrategy { kStrip, kFootprint };
 std::string ToString(GroupingStrategy s);
@@ -121,7 +122,10 @@ struct GroupingPlan {
 // order as one strip, its groups with strip -1. Footprint strategy: images without a surface
 // estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error for bad options, a block
 // of fewer than 2 images, and when 2 images do not fit memory_budget.
-GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options);
+// `geometry`: EstimateBlockGeometry(block) when the caller has it (it reads
+// the block's DEM), else nullptr and it is estimated here.
+GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
+                        const BlockGeometry* geometry = nullptr);
 
 // Like the paper's Table 3: group, image numbers (1-based), image names,
 // number of images, and the memory estimate of each group.
