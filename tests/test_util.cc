@@ -23,15 +23,37 @@ std::filesystem::path SharedDir() {
   return std::filesystem::weakly_canonical(SAPMVS_SHARED_DIR);
 }
 
-std::filesystem::path ScratchDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+namespace {
+
+std::filesystem::path ScratchPath(const ::testing::TestInfo* info) {
   // The pid keeps two runs of the suite (e.g. two build trees) apart.
   std::string name = "sapmvs_test_" + std::to_string(::getpid());
   if (info) name += std::string("_") + info->test_suite_name() + "_" + info->name();
   for (char& c : name) {
     if (c == '/') c = '_';
   }
-  auto dir = std::filesystem::temp_directory_path() / name;
+  return std::filesystem::temp_directory_path() / name;
+}
+
+// Removes a test's scratch folder when the test passed; a failed test's
+// stays for a look.
+class ScratchCleaner : public ::testing::EmptyTestEventListener {
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (!info.result()->Passed()) return;
+    std::error_code ec;
+    std::filesystem::remove_all(ScratchPath(&info), ec);
+  }
+};
+
+const bool kCleanerInstalled = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new ScratchCleaner);
+  return true;
+}();
+
+}  // namespace
+
+std::filesystem::path ScratchDir() {
+  const auto dir = ScratchPath(::testing::UnitTest::GetInstance()->current_test_info());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
