@@ -60,6 +60,11 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--max-waves", m.max_waves, "Stop after this many waves (0 = none)")
       ->capture_default_str();
+  cmd->add_option("--expand-iterations", m.expand_iterations, "Expand-then-filter passes (PMVS: 3)")
+      ->capture_default_str();
+  cmd->add_option("--score-fence", m.score_fence,
+                  "Filter: robust SDs below the seeds' median score a point may lie (0 = off)")
+      ->capture_default_str();
   cmd->add_option("--depth-tolerance", m.depth_tolerance,
                   "Filter: depth agreement, pixel footprints")
       ->capture_default_str();
@@ -70,6 +75,9 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--plane-tolerance", m.plane_tolerance,
                   "Filter: distance to the local plane, footprints")
+      ->capture_default_str();
+  cmd->add_option("--plane-sigmas", m.plane_sigmas,
+                  "Filter: plane tolerance in robust SDs of the distances between patches")
       ->capture_default_str();
   cmd->add_option("--min-cluster", m.min_cluster_size, "Filter: smallest cluster kept, points")
       ->capture_default_str();

@@ -81,6 +81,11 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   sum->largest_wave = std::max(sum->largest_wave, s.largest_wave);
   for (const auto& [size, n] : s.accepted_by_size) sum->accepted_by_size[size] += n;
   sum->points_before_filter += s.points_before_filter;
+  // A run's floor and tolerance: the highest of its groups' (each group has
+  // its own).
+  sum->score_floor = std::max(sum->score_floor, s.score_floor);
+  sum->removed_score += s.removed_score;
+  sum->plane_tolerance = std::max(sum->plane_tolerance, s.plane_tolerance);
   sum->removed_visibility += s.removed_visibility;
   sum->removed_neighbourhood += s.removed_neighbourhood;
   sum->removed_clusters += s.removed_clusters;

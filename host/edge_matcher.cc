@@ -29,11 +29,20 @@ std::vector<EdgeMap> MatchEdges(const MatchGroupData& group, const MatcherOption
     edges[i] = DetectEdges(group.images[i].grey, options.canny_low, options.canny_high);
   }
   std::vector<EdgeMap> maps(n);
+  // The candidates of one image row; rows are searched in parallel and
+  // joined in order, so the result does not depend on the thread count.
+  struct Row {
+    std::vector<EdgeQuery> queries;  // first_patch relative to the row
+    std::vector<NccPatch> patches;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<float> along;  // position along the segment, pixels of the view
+    long edge_pixels = 0;
+  };
   std::vector<EdgeQuery> queries;
   std::vector<NccPatch> patches;
   std::vector<NccPair> pairs;
   std::vector<Eigen::Vector3d> points;
-  std::vector<float> along;  // position along the segment, pixels of the view
+  std::vector<float> along;
   const int margin = options.window_size / 2 + 1;
   for (int i = 0; i < n; ++i) {
     const MatchImage& ref = group.images[i];
@@ -43,10 +52,13 @@ std::vector<EdgeMap> MatchEdges(const MatchGroupData& group, const MatcherOption
     if (ref.views.empty() || !(dmin < dmax)) continue;
     const int j = ref.views[0];
     const Camera& cam = group.images[j].camera;
+    std::vector<Row> rows(ref.grey.rows);
+#pragma omp parallel for schedule(dynamic, 4)
     for (int y = margin; y < ref.grey.rows - margin; ++y) {
+      Row& row = rows[y];
       for (int x = margin; x < ref.grey.cols - margin; ++x) {
         if (!edges[i].at<uint8_t>(y, x)) continue;
-        if (stats) ++stats->edge_pixels;
+        ++row.edge_pixels;
         const Eigen::Vector2d uv(x, y);
         const Eigen::Vector3d p0 = ref.camera.BackProject(uv, dmin);
         const Eigen::Vector3d p1 = ref.camera.BackProject(uv, dmax);
@@ -76,20 +88,32 @@ std::vector<EdgeMap> MatchEdges(const MatchGroupData& group, const MatcherOption
           });
           hits.resize(kMaxEdgeCandidates);
         }
-        EdgeQuery query{i, x, y, static_cast<int>(patches.size()), 0};
+        EdgeQuery query{i, x, y, static_cast<int>(row.patches.size()), 0};
         for (const auto& [t, qi] : hits) {
           const Eigen::Vector3d X = TriangulateMidpoint(ref.camera, uv, cam, qi.cast<double>());
           if (!X.allFinite()) continue;
           const Eigen::Vector3d normal = (ref.camera.center() - X).normalized();
-          const int k = static_cast<int>(patches.size());
-          patches.push_back(MakeNccPatch(X, normal, i));
-          points.push_back(X);
-          along.push_back(static_cast<float>(t));
-          pairs.push_back(NccPair{k, j});
+          row.patches.push_back(MakeNccPatch(X, normal, i));
+          row.points.push_back(X);
+          row.along.push_back(static_cast<float>(t));
           ++query.num_candidates;
         }
-        if (query.num_candidates > 0) queries.push_back(query);
+        if (query.num_candidates > 0) row.queries.push_back(query);
       }
+    }
+    for (Row& row : rows) {
+      if (stats) stats->edge_pixels += row.edge_pixels;
+      const int offset = static_cast<int>(patches.size());
+      for (EdgeQuery q : row.queries) {
+        q.first_patch += offset;
+        queries.push_back(q);
+      }
+      for (size_t k = 0; k < row.patches.size(); ++k) {
+        pairs.push_back(NccPair{offset + static_cast<int>(k), j});
+      }
+      patches.insert(patches.end(), row.patches.begin(), row.patches.end());
+      points.insert(points.end(), row.points.begin(), row.points.end());
+      along.insert(along.end(), row.along.begin(), row.along.end());
     }
   }
   const std::vector<float> scores = engine.Score(patches, pairs);

@@ -60,6 +60,12 @@ std::string FirstProblem(const MatcherOptions& o) {
     s << "plane_tolerance > 0";
   else if (o.min_cluster_size < 0)
     s << "min_cluster_size >= 0";
+  else if (!(o.plane_sigmas >= 0))
+    s << "plane_sigmas >= 0";
+  else if (!(o.score_fence >= 0))
+    s << "score_fence >= 0";
+  else if (o.expand_iterations < 1 || o.expand_iterations > 10)
+    s << "expand_iterations in 1..10";
   if (!s.str().empty()) return s.str();
   // PMVS uses window_size alone and ignores adaptive_sizes.
   if (o.mode == MatchMode::kSapmvs) {
@@ -125,7 +131,15 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     const double device_now = engine_ptr ? DeviceSeconds(*engine_ptr) : 0;
     t.device = device_now - device_before;
     device_before = device_now;
-    stats.stages.emplace_back(name, t);
+    // Stages repeated by the expand-filter passes add up under one name.
+    auto same = std::find_if(stats.stages.begin(), stats.stages.end(),
+                             [&](const auto& s) { return s.first == name; });
+    if (same == stats.stages.end()) {
+      stats.stages.emplace_back(name, t);
+    } else {
+      same->second.wall += t.wall;
+      same->second.device += t.device;
+    }
     stage_start = std::chrono::steady_clock::now();
   };
 
@@ -179,24 +193,6 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     end_stage("edges");
   }
 
-  propagator.RunWaves([&](long wave, long size, long points) {
-    if (!show) return;
-    std::fprintf(stderr, "\r%s: wave %ld, %ld candidates, %ld points   ",
-                 ToString(options.mode).c_str(), wave, size, points);
-    std::fflush(stderr);
-  });
-  if (show) std::fprintf(stderr, "\n");
-  stats.candidates = propagator.candidates();
-  stats.waves = propagator.waves();
-  stats.largest_wave = propagator.largest_wave();
-  stats.patches = static_cast<long>(propagator.patches().size());
-  for (const AcceptedPatch& p : propagator.patches()) ++stats.accepted_by_size[p.size];
-  end_stage("propagation");
-
-  const auto& points = propagator.points();
-  const auto& patches = propagator.patches();
-  stats.points_before_filter = static_cast<long>(points.size());
-  std::vector<bool> keep = FilterPoints(group, options, points, patches, &stats);
   // Gross errors: a point whose depth in its reference image is a far-out
   // value of that image's seed depths (Tukey's fences, 3 interquartile ranges
   // beyond the quartiles, plus 10 GSD) is a false match that grew into a
@@ -212,18 +208,62 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     const double pad = 3.0 * (q3 - q1) + 10.0 * group.gsd;
     plausible[i] = {q1 - pad, q3 + pad};
   }
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!keep[i]) continue;
-    const int ref = patches[points[i].patch].ref;
-    const auto [lo, hi] = plausible[ref];
-    if (lo == 0 && hi == 0) continue;
-    const double depth = group.images[ref].camera.Depth(points[i].x);
-    if (depth < lo || depth > hi) {
-      keep[i] = false;
-      ++stats.removed_depth_range;
+  const auto& points = propagator.points();
+  const auto& patches = propagator.patches();
+  std::vector<bool> keep;
+  // PMVS's loop: expand, filter, and expand again into the ground the
+  // filter freed; every pass filters all points, old and new.
+  for (int pass = 0; pass < options.expand_iterations; ++pass) {
+    if (pass > 0) propagator.Prune(keep);
+    propagator.RunWaves([&](long wave, long size, long emitted) {
+      if (!show) return;
+      std::fprintf(stderr, "\r%s: pass %d, wave %ld, %ld candidates, %ld points   ",
+                   ToString(options.mode).c_str(), pass + 1, wave, size, emitted);
+      std::fflush(stderr);
+    });
+    if (show) std::fprintf(stderr, "\n");
+    end_stage("propagation");
+
+    if (pass == 0) {
+      // The fence, from the scores of the points of the first expansion.
+      stats.score_floor = options.threshold;
+      if (options.score_fence > 0 && points.size() >= 10) {
+        std::vector<double> s;
+        for (const DensePoint& d : points) s.push_back(patches[d.patch].score);
+        std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+        const double median = s[s.size() / 2];
+        for (double& v : s) v = std::abs(v - median);
+        std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+        const double sigma = 1.4826 * s[s.size() / 2];
+        stats.score_floor = std::max(options.threshold, median - options.score_fence * sigma);
+      }
     }
+    MatchStats removed;
+    keep = FilterPoints(group, options, points, patches, &removed, stats.score_floor);
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (!keep[i]) continue;
+      const int ref = patches[points[i].patch].ref;
+      const auto [lo, hi] = plausible[ref];
+      if (lo == 0 && hi == 0) continue;
+      const double depth = group.images[ref].camera.Depth(points[i].x);
+      if (depth < lo || depth > hi) {
+        keep[i] = false;
+        ++stats.removed_depth_range;
+      }
+    }
+    stats.removed_score += removed.removed_score;
+    stats.plane_tolerance = removed.plane_tolerance;
+    stats.removed_visibility += removed.removed_visibility;
+    stats.removed_neighbourhood += removed.removed_neighbourhood;
+    stats.removed_clusters += removed.removed_clusters;
+    end_stage("filter");
   }
-  end_stage("filter");
+  stats.candidates = propagator.candidates();
+  stats.waves = propagator.waves();
+  stats.largest_wave = propagator.largest_wave();
+  stats.points_before_filter = propagator.emitted();
+  stats.patches = static_cast<long>(patches.size());
+  for (const AcceptedPatch& p : patches) ++stats.accepted_by_size[p.size];
 
   PointCloud& cloud = result.cloud;
   cloud.has_normals = cloud.has_colors = cloud.has_scores = cloud.has_views = true;

@@ -33,7 +33,9 @@ int Find(std::vector<int>& parent, int i) {
 
 std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOptions& options,
                                    const std::vector<DensePoint>& points,
-                                   const std::vector<AcceptedPatch>& patches) {
+                                   const std::vector<AcceptedPatch>& patches,
+                                   const std::vector<bool>& eligible) {
+  auto in = [&](size_t i) { return eligible.empty() || eligible[i]; };
   const int n = static_cast<int>(group.images.size());
   const int cs = options.cell_size;
   struct Buffer {
@@ -50,24 +52,33 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     b.front.assign(size, 0);
     b.back.assign(size, 0);
   }
+  // Cell, depth and depth tolerance of point x in image v; false when x is
+  // behind the camera or off the image.
+  auto locate = [&](int v, const Eigen::Vector3d& x, size_t* cell, double* d, double* tol) {
+    const Camera& cam = group.images[v].camera;
+    *d = cam.Depth(x);
+    if (!(*d > 0)) return false;
+    const Eigen::Vector2d uv = cam.Project(x);
+    const int cx = static_cast<int>(std::floor((uv.x() + 0.5) / cs));
+    const int cy = static_cast<int>(std::floor((uv.y() + 0.5) / cs));
+    if (cx < 0 || cy < 0 || cx >= buffers[v].cols || cy >= buffers[v].rows) return false;
+    *cell = static_cast<size_t>(cy) * buffers[v].cols + cx;
+    *tol = options.depth_tolerance * *d / cam.intrinsics().MeanFocal();
+    return true;
+  };
   // (image, cell, depth) of each point in each image it was matched in.
   auto for_each_view = [&](size_t i, auto&& f) {
     const AcceptedPatch& patch = patches[points[i].patch];
     auto visit = [&](int v) {
-      const Camera& cam = group.images[v].camera;
-      const double d = cam.Depth(points[i].x);
-      if (!(d > 0)) return;
-      const Eigen::Vector2d uv = cam.Project(points[i].x);
-      const int x = static_cast<int>(std::floor((uv.x() + 0.5) / cs));
-      const int y = static_cast<int>(std::floor((uv.y() + 0.5) / cs));
-      if (x < 0 || y < 0 || x >= buffers[v].cols || y >= buffers[v].rows) return;
-      const double tol = options.depth_tolerance * d / cam.intrinsics().MeanFocal();
-      f(v, static_cast<size_t>(y) * buffers[v].cols + x, d, tol);
+      size_t cell = 0;
+      double d = 0, tol = 0;
+      if (locate(v, points[i].x, &cell, &d, &tol)) f(v, cell, d, tol);
     };
     visit(patch.ref);
     for (const int v : patch.views) visit(v);
   };
   for (size_t i = 0; i < points.size(); ++i) {
+    if (!in(i)) continue;
     for_each_view(i, [&](int v, size_t cell, double d, double) {
       float& m = buffers[v].min_depth[cell];
       m = std::min(m, static_cast<float>(d));
@@ -78,6 +89,7 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     return static_cast<float>((1 + p.views.size()) * std::max(0.0f, p.score));
   };
   for (size_t i = 0; i < points.size(); ++i) {
+    if (!in(i)) continue;
     const float w = weight(i);
     for_each_view(i, [&](int v, size_t cell, double d, double tol) {
       Buffer& b = buffers[v];
@@ -85,30 +97,56 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     });
   }
   std::vector<bool> keep(points.size(), false);
+#pragma omp parallel for schedule(static)
   for (size_t i = 0; i < points.size(); ++i) {
+    if (!in(i)) continue;
     int visible = 0;
     bool occluding = false;
+    std::vector<uint8_t> own(n, 0);
     for_each_view(i, [&](int v, size_t cell, double d, double tol) {
+      own[v] = 1;
       const Buffer& b = buffers[v];
       if (d <= b.min_depth[cell] + tol) {
         ++visible;
         if (b.front[cell] < b.back[cell]) occluding = true;
       }
     });
-    keep[i] = visible >= options.min_image_num && !occluding;
+    // Free space: in an image the point was not matched in, a surface that
+    // image did match lying farther along the same line of sight was seen
+    // through the point, so the point floats in empty space (a window that
+    // fattened a roof over the ground beside it). It goes when those
+    // surfaces carry more support than it does.
+    float violated = 0;
+    if (!occluding) {
+      for (int v = 0; v < n; ++v) {
+        size_t cell = 0;
+        double d = 0, tol = 0;
+        if (own[v] || !locate(v, points[i].x, &cell, &d, &tol)) continue;
+        if (d < buffers[v].min_depth[cell] - tol) violated += buffers[v].front[cell];
+      }
+    }
+    keep[i] = visible >= options.min_image_num && !occluding && violated <= weight(i);
   }
   return keep;
 }
 
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
-                               const std::vector<AcceptedPatch>& patches, MatchStats* stats) {
-  std::vector<bool> keep = VisibilityFilter(group, options, points, patches);
+                               const std::vector<AcceptedPatch>& patches, MatchStats* stats,
+                               double score_floor) {
+  std::vector<bool> eligible(points.size());
+  long low = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    eligible[i] = patches[points[i].patch].score >= score_floor;
+    low += !eligible[i];
+  }
+  stats->removed_score = low;
+  std::vector<bool> keep = VisibilityFilter(group, options, points, patches, eligible);
   std::vector<int> alive;
   for (size_t i = 0; i < points.size(); ++i) {
     if (keep[i]) alive.push_back(static_cast<int>(i));
   }
-  stats->removed_visibility = static_cast<long>(points.size() - alive.size());
+  stats->removed_visibility = static_cast<long>(points.size() - alive.size()) - low;
   if (alive.empty()) return keep;
 
   std::vector<float> xyz(alive.size() * 3);
@@ -126,6 +164,34 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
   params.cores = 0;
   index.knnSearch(data, nn_m, nd_m, k, params);
+
+  // The plane tolerance, from how far the points of neighbouring patches lie
+  // from each other's planes: at least plane_tolerance footprints, else
+  // plane_sigmas robust standard deviations of those distances (1.4826 x
+  // their median, as for half-normal residuals). Depth noise between patches
+  // differs with texture and geometry (median 0.18 footprints on the
+  // simulator's `small`, 0.43 on NGI's scans); one fixed tolerance either lets
+  // roof planes stray over the ground on the one or strips the other.
+  std::vector<float> foreign_distance;
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    const AcceptedPatch& patch = patches[p.patch];
+    const double fp = Footprint(group.images[patch.ref].camera, p.x);
+    const double r = options.neighbour_radius * fp;
+    for (int j = 0; j < k; ++j) {
+      const size_t b = nn[a * k + j];
+      if (b == a || nd[a * k + j] > r * r || points[alive[b]].patch == p.patch) continue;
+      foreign_distance.push_back(
+          static_cast<float>(std::abs(patch.normal.dot(points[alive[b]].x - patch.center)) / fp));
+    }
+  }
+  double tolerance = options.plane_tolerance;
+  if (!foreign_distance.empty()) {
+    auto mid = foreign_distance.begin() + foreign_distance.size() / 2;
+    std::nth_element(foreign_distance.begin(), mid, foreign_distance.end());
+    tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * *mid);
+  }
+  stats->plane_tolerance = tolerance;
 
   // 2. Neighbourhood and local plane.
   std::vector<float> radius(alive.size());
@@ -149,7 +215,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     for (const auto& q : nbr) cov += (q - mean) * (q - mean).transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
     const Eigen::Vector3d normal = es.eigenvectors().col(0);
-    pass[a] = std::abs(normal.dot(p.x - mean)) <= options.plane_tolerance * fp;
+    pass[a] = std::abs(normal.dot(p.x - mean)) <= tolerance * fp;
   }
   // 2b. Patch support: the points of other patches next to a patch must lie
   // on its plane. A sapmvs patch emits hundreds of points on one plane, which
@@ -167,7 +233,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       const DensePoint& q = points[alive[b]];
       if (q.patch == p.patch) continue;
       ++foreign[p.patch];
-      if (std::abs(patch.normal.dot(q.x - patch.center)) <= options.plane_tolerance * fp) {
+      if (std::abs(patch.normal.dot(q.x - patch.center)) <= tolerance * fp) {
         ++consistent[p.patch];
       }
     }

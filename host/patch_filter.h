@@ -1,5 +1,6 @@
 #pragma once
-// Filtering of the matched points (method.md 3.5), in three passes:
+// Filtering of the matched points (method.md 3.5). Points of patches that
+// score below the caller's score floor go first; then three passes:
 //  1. visibility: per image, a depth buffer on the cell grid from every
 //     point's reference and photo-consistent views. A point is occluded in an
 //     image where the front-most surface of its cell lies more than
@@ -7,9 +8,15 @@
 //     least min_image_num images. A cell whose front-most points carry less
 //     support (num_views x score) than the points they hide counts those
 //     front points as occluding outliers, and they go (PMVS's filter 1).
+//     Free space: a point lying in front of a surface that an image it was
+//     not matched in did match there (so that image saw through it) goes when
+//     that surface carries more support than the point;
 //  2. neighbourhood: a point needs min_neighbours points within
-//     neighbour_radius footprints and must lie within plane_tolerance
-//     footprints of the plane they fit;
+//     neighbour_radius footprints and must lie within the plane tolerance of
+//     the plane they fit, and a patch's plane must pass within it of most
+//     points of other patches around it. The tolerance is plane_sigmas robust
+//     standard deviations of those patch-to-patch distances, at least
+//     plane_tolerance footprints;
 //  3. clusters: points linked within neighbour_radius footprints form
 //     clusters; those smaller than min_cluster_size go.
 #include <vector>
@@ -20,14 +27,20 @@
 
 namespace sapmvs {
 
-// keep[i] for points[i]; stats' removed_* counters are filled.
+// keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
+// filled. Points of
+// patches scoring below `score_floor` go first (removed_score) and take no
+// part in the other passes.
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
-                               const std::vector<AcceptedPatch>& patches, MatchStats* stats);
+                               const std::vector<AcceptedPatch>& patches, MatchStats* stats,
+                               double score_floor = 0);
 
-// The visibility pass alone (tests): keep[i] after pass 1.
+// The visibility pass alone (tests): keep[i] after pass 1, among the points
+// where `eligible` is true (all when empty).
 std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOptions& options,
                                    const std::vector<DensePoint>& points,
-                                   const std::vector<AcceptedPatch>& patches);
+                                   const std::vector<AcceptedPatch>& patches,
+                                   const std::vector<bool>& eligible = {});
 
 }  // namespace sapmvs

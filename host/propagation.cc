@@ -115,6 +115,7 @@ bool Propagator::Emit(const AcceptedPatch& patch) {
     }
   }
   if (points_.size() == first_point) return false;
+  emitted_ += static_cast<long>(points_.size() - first_point);
   // The views' cells where the points land are covered too, so the same
   // ground is not matched again with another reference.
   for (const int v : patch.views) {
@@ -212,6 +213,47 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds) {
     const Camera& cam = group_.images[patches_[p].ref].camera;
     seed_depths_[patches_[p].ref].push_back(cam.Depth(patches_[p].center));
     Expand(static_cast<int>(p), &front_);
+  }
+}
+
+void Propagator::Prune(const std::vector<bool>& keep) {
+  const int cs = options_.cell_size;
+  std::vector<DensePoint> kept;
+  kept.reserve(points_.size());
+  for (size_t i = 0; i < points_.size(); ++i) {
+    if (keep[i]) kept.push_back(points_[i]);
+  }
+  points_.swap(kept);
+  std::vector<std::vector<int>> before(grids_.size());
+  for (size_t g = 0; g < grids_.size(); ++g) {
+    before[g].swap(grids_[g].owner);
+    grids_[g].owner.assign(before[g].size(), -1);
+  }
+  // Cells are owned again exactly as Emit owned them: the reference cell of
+  // each point, and the view cells its points land in.
+  std::vector<uint8_t> alive(patches_.size(), 0);
+  for (const DensePoint& d : points_) {
+    alive[d.patch] = 1;
+    Grid& grid = grids_[patches_[d.patch].ref];
+    const int cell = grid.Index(d.uv.cast<double>(), cs);
+    if (cell >= 0) grid.owner[cell] = d.patch;
+  }
+  for (const DensePoint& d : points_) {
+    for (const int v : patches_[d.patch].views) {
+      const Camera& vc = group_.images[v].camera;
+      if (!(vc.Depth(d.x) > 0)) continue;
+      const int cell = grids_[v].Index(vc.Project(d.x), cs);
+      if (cell >= 0 && grids_[v].owner[cell] == -1) grids_[v].owner[cell] = d.patch;
+    }
+  }
+  for (size_t g = 0; g < grids_.size(); ++g) {
+    for (size_t c = 0; c < before[g].size(); ++c) {
+      if (before[g][c] != -1 && grids_[g].owner[c] == -1) grids_[g].tries[c] = 0;
+    }
+  }
+  front_.clear();
+  for (size_t p = 0; p < patches_.size(); ++p) {
+    if (alive[p]) Expand(static_cast<int>(p), &front_);
   }
 }
 

@@ -46,6 +46,11 @@ class Propagator {
   // Waves until the front is empty (or max_waves). `on_wave` (may be empty)
   // is called after each wave with its number, its size and the points.
   void RunWaves(const std::function<void(long, long, long)>& on_wave);
+  // Drops the points where keep[i] is false and frees their cells in every
+  // grid, then queues the expansion of every patch that still has points
+  // (PMVS's expand-filter iterations: the ground a false patch held is open
+  // to its neighbours' planes again). The freed cells may be tried again.
+  void Prune(const std::vector<bool>& keep);
 
   const std::vector<AcceptedPatch>& patches() const { return patches_; }
   const std::vector<DensePoint>& points() const { return points_; }
@@ -54,6 +59,8 @@ class Propagator {
   long candidates() const { return candidates_; }
   long waves() const { return waves_; }
   long largest_wave() const { return largest_wave_; }
+  // Points emitted so far, including those Prune dropped.
+  long emitted() const { return emitted_; }
   // Depths of the accepted seeds, per image (for the edge search range).
   const std::vector<std::vector<double>>& seed_depths() const { return seed_depths_; }
 
@@ -82,6 +89,7 @@ class Propagator {
   std::vector<PatchCandidate> front_;
   std::vector<std::vector<double>> seed_depths_;
   long seeds_tried_ = 0, seeds_accepted_ = 0, candidates_ = 0, waves_ = 0, largest_wave_ = 0;
+  long emitted_ = 0;
 };
 
 // Intersection of the ray through pixel uv of `camera` with the plane

@@ -35,10 +35,13 @@ nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
           {"use_edges", m.use_edges},
           {"max_wave", m.max_wave},
           {"max_waves", m.max_waves},
+          {"expand_iterations", m.expand_iterations},
+          {"score_fence", m.score_fence},
           {"depth_tolerance", m.depth_tolerance},
           {"neighbour_radius", m.neighbour_radius},
           {"min_neighbours", m.min_neighbours},
           {"plane_tolerance", m.plane_tolerance},
+          {"plane_sigmas", m.plane_sigmas},
           {"min_cluster_size", m.min_cluster_size}};
 }
 
@@ -56,6 +59,9 @@ nlohmann::json MatchStatsJson(const MatchStats& s) {
   for (const auto& [size, count] : s.accepted_by_size) sizes[std::to_string(size)] = count;
   j["propagation"]["accepted_by_size"] = sizes;
   j["filter"] = {{"points_before", s.points_before_filter},
+                 {"score_floor", s.score_floor},
+                 {"plane_tolerance", s.plane_tolerance},
+                 {"removed_score", s.removed_score},
                  {"removed_visibility", s.removed_visibility},
                  {"removed_neighbourhood", s.removed_neighbourhood},
                  {"removed_clusters", s.removed_clusters},

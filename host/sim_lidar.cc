@@ -33,19 +33,7 @@ std::vector<PointRecord> SimulateLidar(const Scene& scene, const LidarSpec& spec
         p.x = hit.point.x() + nxy(rng) + offset.x();
         p.y = hit.point.y() + nxy(rng) + offset.y();
         p.z = hit.point.z() + nz(rng) + offset.z();
-        switch (hit.cls) {
-          case SurfaceClass::kRoof:
-            p.classification = 6;
-            break;
-          case SurfaceClass::kTree:
-            p.classification = 5;
-            break;
-          case SurfaceClass::kWater:
-            p.classification = 9;
-            break;
-          default:
-            p.classification = 2;
-        }
+        p.classification = LasClass(hit.cls);
         if (hit.wall) p.classification = 6;
         const double albedo = scene.Albedo(hit).mean();
         p.intensity = static_cast<uint16_t>(std::clamp(albedo, 0.0, 1.0) * 65535);

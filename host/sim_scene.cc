@@ -11,6 +11,19 @@
 #include "sapmvs/error.h"
 
 namespace sapmvs::sim {
+
+uint8_t LasClass(SurfaceClass k) {
+  switch (k) {
+    case SurfaceClass::kRoof:
+      return 6;
+    case SurfaceClass::kTree:
+      return 5;
+    case SurfaceClass::kWater:
+      return 9;
+    default:
+      return 2;
+  }
+}
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

@@ -233,6 +233,13 @@ SimulateSummary Simulate(const SimulateOptions& o) {
       dsm.at(col, row) =
           static_cast<float>(scene.CellHeight(col, dsm.height - 1 - row) + offset.z());
   WriteGeoTiff(o.out / "truth" / "dsm.tif", dsm);
+  // The class of each DSM cell, so that checks can tell water (nothing to
+  // match) and trees from ground and roofs.
+  GeoRaster classes = dsm;
+  for (int row = 0; row < dsm.height; ++row)
+    for (int col = 0; col < dsm.width; ++col)
+      classes.at(col, row) = sim::LasClass(scene.CellClass(col, dsm.height - 1 - row));
+  WriteGeoTiff(o.out / "truth" / "classes.tif", classes);
 
   sim::LidarSpec lidar;
   lidar.density = sim::LidarDensityForGsd(world.gsd);
@@ -269,6 +276,8 @@ SimulateSummary Simulate(const SimulateOptions& o) {
          << " grey levels.\n"
          << "- `truth/dsm.tif`: the exact first-surface heights, " << Fixed(scene.cell(), 4)
          << " m cells (flat-topped: walls are vertical).\n"
+         << "- `truth/classes.tif`: the LAS class of each DSM cell (2 ground, 5 vegetation, "
+            "6 building, 9 water).\n"
          << "- `truth/lidar.las`" << (o.xyz ? " and `truth/lidar.xyz`" : "") << ": "
          << points.size() << " simulated first returns, " << Fixed(lidar.density, 2)
          << " points/m^2 per strip, "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "sapmvs/error.h"
 
@@ -35,12 +36,36 @@ bool Occluded(const GeoRaster& r, const Eigen::Vector3d& p, const Eigen::Vector3
   return false;
 }
 
+// LAS class of the cell under (x, y) of a raster on the surface's grid; -1
+// without one or outside.
+int CellClass(const GeoRaster* classes, double x, double y) {
+  if (!classes) return -1;
+  const double v = CellHeight(*classes, x, y);
+  return std::isfinite(v) ? static_cast<int>(std::lround(v)) : -1;
+}
+
 }  // namespace
+
+std::optional<GeoRaster> ReadClassRasterBeside(const std::string& truth_path) {
+  const auto path = std::filesystem::path(truth_path).parent_path() / "classes.tif";
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  return ReadGeoRaster(path);
+}
 
 SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
                                  const Block& block, const SurfaceCheckOptions& options) {
   if (!(options.tolerance > 0) || !(options.cell_size > 0)) {
     throw Error("surface check: tolerance and cell size must be > 0");
+  }
+  if (const GeoRaster* k = options.classes) {
+    if (k->width != surface.width || k->height != surface.height ||
+        std::abs(k->origin_x - surface.origin_x) > 1e-6 * surface.cell_size ||
+        std::abs(k->origin_y - surface.origin_y) > 1e-6 * surface.cell_size ||
+        std::abs(k->cell_size - surface.cell_size) > 1e-9 * surface.cell_size) {
+      throw Error("surface check: the class raster is not on the surface's grid (expected " +
+                  std::to_string(surface.width) + " x " + std::to_string(surface.height) +
+                  " cells of the same size and origin)");
+    }
   }
   SurfaceCheck out;
   out.points = static_cast<long>(cloud.points.size());
@@ -58,8 +83,11 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
     ++out.checked;
     const double dz = std::abs(p.position.z() - h);
     abs_dz.push_back(dz);
+    const int k = CellClass(options.classes, p.position.x(), p.position.y());
+    if (k >= 0) ++out.by_class[k].checked;
     if (dz > options.tolerance) continue;
     ++out.within;
+    if (k >= 0) ++out.by_class[k].within;
     const int c = static_cast<int>(std::floor((p.position.x() - x0) / options.cell_size));
     const int r = static_cast<int>(std::floor((y0 - p.position.y()) / options.cell_size));
     if (c >= 0 && r >= 0 && c < cols && r < rows) covered[static_cast<size_t>(r) * cols + c] = 1;
@@ -75,8 +103,9 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
       top = std::max(top, static_cast<double>(surface.values[i]));
     }
   }
-  long seen = 0, hit = 0;
-#pragma omp parallel for reduction(+ : seen, hit) schedule(dynamic, 8)
+  // Per coverage cell: -2 not seen, else its class (-1 without a raster).
+  std::vector<int> seen_class(covered.size(), -2);
+#pragma omp parallel for schedule(dynamic, 8)
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       const double x = x0 + (c + 0.5) * options.cell_size;
@@ -92,10 +121,24 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
         if (Occluded(surface, p, cam.center(), top)) continue;
         if (++views >= options.min_images) break;
       }
-      if (views < options.min_images) continue;
-      ++seen;
-      if (covered[static_cast<size_t>(r) * cols + c]) ++hit;
+      if (views >= options.min_images) {
+        seen_class[static_cast<size_t>(r) * cols + c] = CellClass(options.classes, x, y);
+      }
     }
+  }
+  long seen = 0, hit = 0;
+  for (size_t i = 0; i < seen_class.size(); ++i) {
+    const int k = seen_class[i];
+    if (k == -2) continue;
+    if (k >= 0) {
+      ClassCheck& cc = out.by_class[k];
+      ++cc.cells_seen;
+      if (covered[i]) ++cc.cells_covered;
+      const auto& skip = options.unmatchable_classes;
+      if (std::find(skip.begin(), skip.end(), k) != skip.end()) continue;
+    }
+    ++seen;
+    if (covered[i]) ++hit;
   }
   out.cells_seen = seen;
   out.cells_covered = hit;

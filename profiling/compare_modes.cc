@@ -38,6 +38,10 @@ int main(int argc, char** argv) {
   app.add_option("--level", level, "Pyramid level")->capture_default_str();
   app.add_option("--device", device, "OpenCL device");
   app.add_option("--csv", csv_path, "Write the rows as CSV");
+  double coverage_cells = 1;
+  app.add_option("--coverage-cells", coverage_cells,
+                 "Coverage cell side in nominal point spacings (csize pixels at the level)")
+      ->capture_default_str();
   std::string only;
   MatcherOptions base;
   app.add_option("--only", only, "Run one mode: sapmvs or pmvs");
@@ -46,12 +50,19 @@ int main(int argc, char** argv) {
   app.add_option("--min-image-num", base.min_image_num, "MatcherOptions::min_image_num");
   app.add_option("--depth-tolerance", base.depth_tolerance, "MatcherOptions::depth_tolerance");
   app.add_option("--plane-tolerance", base.plane_tolerance, "MatcherOptions::plane_tolerance");
+  app.add_option("--plane-sigmas", base.plane_sigmas, "MatcherOptions::plane_sigmas");
+  app.add_option("--score-fence", base.score_fence, "MatcherOptions::score_fence");
+  app.add_option("--expand-iterations", base.expand_iterations,
+                 "MatcherOptions::expand_iterations");
   app.add_option("--adaptive-sizes", base.adaptive_sizes, "MatcherOptions::adaptive_sizes")
       ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   try {
     const Block block = ReadBlock(block_path);
     const GeoRaster truth = ReadGeoRaster(truth_path);
+    // With the simulator's classes.tif beside the truth: water is not asked
+    // to be covered, and the rows split by class.
+    const std::optional<GeoRaster> classes = ReadClassRasterBeside(truth_path);
     const double gsd = EstimateBlockGeometry(block).gsd_median;  // full resolution
     DeviceOptions dev;
     dev.device = device;
@@ -79,7 +90,8 @@ int main(int argc, char** argv) {
       row.points = r.stats.points;
       SurfaceCheckOptions so;
       so.tolerance = gsd;
-      so.cell_size = o.cell_size * std::ldexp(1.0, level) * gsd;
+      so.cell_size = coverage_cells * o.cell_size * std::ldexp(1.0, level) * gsd;
+      if (classes) so.classes = &*classes;
       row.check = CheckAgainstSurface(r.cloud, truth, block, so);
       if (const char* dump = std::getenv("SAPMVS_DUMP_DZ")) {
         std::ofstream d(std::string(dump) + "_" + row.mode + ".txt");
@@ -95,11 +107,13 @@ int main(int argc, char** argv) {
       rows.push_back(row);
       std::cerr << row.mode << ": " << r.stats.patches << " patches, " << r.stats.waves
                 << " waves, " << r.stats.candidates << " candidates, filter "
-                << r.stats.points_before_filter << " -> " << r.stats.points << "\n";
+                << r.stats.points_before_filter << " -> " << r.stats.points << ", score floor "
+                << r.stats.score_floor << " (" << r.stats.removed_score
+                << " below), plane tolerance " << r.stats.plane_tolerance << "\n";
     }
     std::cout << "block " << block_path << ", level " << level << ", GSD " << gsd
-              << " (tolerance 1 GSD; coverage cells of " << 2 * std::ldexp(1.0, level) * gsd
-              << ")\n";
+              << " (tolerance 1 GSD; coverage cells of "
+              << coverage_cells * base.cell_size * std::ldexp(1.0, level) * gsd << ")\n";
     std::cout << std::left << std::setw(8) << "mode" << std::right << std::setw(10) << "wall s"
               << std::setw(11) << "kernel s" << std::setw(10) << "points" << std::setw(12)
               << "<=1 GSD" << std::setw(12) << "median|dz|" << std::setw(11) << "coverage"
@@ -111,6 +125,20 @@ int main(int argc, char** argv) {
                 << std::setprecision(1) << 100 * r.check.share_within << "%" << std::setw(12)
                 << std::setprecision(3) << r.check.median_abs_dz << std::setw(10)
                 << std::setprecision(1) << 100 * r.check.coverage << "%\n";
+    }
+    if (classes) {
+      std::cout << "by class (2 ground, 5 trees, 6 roofs, 9 water; water cells are not counted as "
+                   "seen):\n";
+      for (const Row& r : rows) {
+        for (const auto& [k, c] : r.check.by_class) {
+          std::cout << "  " << std::left << std::setw(8) << r.mode << "class " << std::setw(3) << k
+                    << std::right << std::setw(9) << c.checked << " pts" << std::setw(7)
+                    << std::setprecision(1) << (c.checked ? 100.0 * c.within / c.checked : 0.0)
+                    << "% within" << std::setw(9) << c.cells_seen << " cells" << std::setw(7)
+                    << (c.cells_seen ? 100.0 * c.cells_covered / c.cells_seen : 0.0)
+                    << "% covered\n";
+        }
+      }
     }
     if (rows.size() == 2) {
       const Row& p = rows[0];

@@ -115,6 +115,8 @@ int main(int argc, char** argv) {
       }
       const Block block = ReadBlock(sim / "block.yaml");
       const GeoRaster truth = ReadGeoRaster(sim / "truth" / "dsm.tif");
+      const std::optional<GeoRaster> classes =
+          ReadClassRasterBeside((sim / "truth" / "dsm.tif").string());
       const double gsd = EstimateBlockGeometry(block).gsd_median;
       for (const char* mode : {"sapmvs", "pmvs"}) {
         std::cerr << preset << " " << mode << "...\n";
@@ -142,6 +144,7 @@ int main(int argc, char** argv) {
         SurfaceCheckOptions sc;
         sc.tolerance = gsd;
         sc.cell_size = 2 * std::ldexp(1.0, level) * gsd;
+        if (classes) sc.classes = &*classes;
         row.check = CheckAgainstSurface(ReadPly(o.out / "cloud.ply"), truth, block, sc);
         rows.push_back(row);
       }

@@ -97,6 +97,8 @@ int main(int argc, char** argv) {
     SurfaceCheckOptions so;
     so.tolerance = gsd;
     so.cell_size = 2 * std::ldexp(1.0, level) * gsd;
+    const std::optional<GeoRaster> classes = ReadClassRasterBeside(truth_path);
+    if (classes) so.classes = &*classes;
     std::cout << "run " << run_dir << ": " << cloud.points.size() << " points, " << centers.size()
               << " groups; GSD " << gsd << ", border band +-" << band << " (" << band_gsd
               << " GSD)\n";

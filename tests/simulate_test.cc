@@ -195,6 +195,30 @@ TEST(Simulate, TruthFilesAreValidAndAgree) {
   const double density = las.points.size() / ((xmax - xmin) * (ymax - ymin));
   EXPECT_GT(density, 1.0);
   EXPECT_LT(density, 4.0 * 2.5);  // strips overlap
+  // The class raster lies on the DSM's grid, holds LAS codes only, and agrees
+  // with the LiDAR's classes, which come from ray hits, not from the raster
+  // (walls and the 5 cm horizontal noise make the few that differ).
+  const GeoRaster classes = ReadGeoRaster(dir / "truth" / "classes.tif");
+  ASSERT_EQ(classes.width, dsm.width);
+  ASSERT_EQ(classes.height, dsm.height);
+  EXPECT_EQ(classes.origin_x, dsm.origin_x);
+  EXPECT_EQ(classes.origin_y, dsm.origin_y);
+  EXPECT_EQ(classes.cell_size, dsm.cell_size);
+  std::map<int, long> cells;
+  for (const float v : classes.values) ++cells[static_cast<int>(v)];
+  for (const auto& [k, n] : cells) EXPECT_TRUE(k == 2 || k == 5 || k == 6 || k == 9) << k;
+  EXPECT_GT(cells[2], cells[6]);
+  EXPECT_GT(cells[6], 0);
+  long agree = 0, total = 0;
+  for (const PointRecord& p : las.points) {
+    const int c = static_cast<int>((p.x - classes.origin_x) / classes.cell_size);
+    const int r = static_cast<int>((classes.origin_y - p.y) / classes.cell_size);
+    if (c < 0 || r < 0 || c >= classes.width || r >= classes.height) continue;
+    ++total;
+    agree += static_cast<int>(classes.at(c, r)) == p.classification;
+  }
+  ASSERT_GT(total, 10000);
+  EXPECT_GT(static_cast<double>(agree) / total, 0.95) << agree << " of " << total;
 }
 
 TEST(Simulate, AngleFlagsChangeTheFileNotTheCameras) {

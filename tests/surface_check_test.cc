@@ -230,4 +230,75 @@ TEST(CheckAgainstSurface, BadOptionsThrow) {
 }
 
 }  // namespace
+// Classes on the surface's grid: the north half ground (2), the south-west
+// quarter water (9), the south-east quarter building (6).
+GeoRaster QuarterClasses() {
+  GeoRaster k = FlatSurface();
+  for (int row = 0; row < kRasterCells; ++row) {
+    for (int col = 0; col < kRasterCells; ++col) {
+      k.at(col, row) = row < kRasterCells / 2 ? 2.0f : (col < kRasterCells / 2 ? 9.0f : 6.0f);
+    }
+  }
+  return k;
+}
+
+TEST(CheckAgainstSurface, ClassesSplitTheCountsAndWaterIsNeverSeen) {
+  // Every cell has a point on the surface except the building's, whose points
+  // are two tolerances up.
+  PointCloud cloud = PointPerCell();
+  for (CloudPoint& p : cloud.points) {
+    if (p.position.y() < kY0 - 50 && p.position.x() >= kX0 + 50) p.position.z() += 2 * kTolerance;
+  }
+  const GeoRaster classes = QuarterClasses();
+  SurfaceCheckOptions o = Options();
+  o.classes = &classes;
+  const SurfaceCheck s = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), o);
+  const long quarter = kCheckCells * kCheckCells / 4;
+  ASSERT_EQ(s.by_class.size(), 3u);
+  const ClassCheck& ground = s.by_class.at(2);
+  const ClassCheck& water = s.by_class.at(9);
+  const ClassCheck& roof = s.by_class.at(6);
+  EXPECT_EQ(ground.checked, 2 * quarter);
+  EXPECT_EQ(ground.within, 2 * quarter);
+  EXPECT_EQ(ground.cells_seen, 2 * quarter);
+  EXPECT_EQ(ground.cells_covered, 2 * quarter);
+  EXPECT_EQ(roof.checked, quarter);
+  EXPECT_EQ(roof.within, 0);
+  EXPECT_EQ(roof.cells_seen, quarter);
+  EXPECT_EQ(roof.cells_covered, 0);
+  // Water's points count for accuracy; its cells are listed but not seen.
+  EXPECT_EQ(water.checked, quarter);
+  EXPECT_EQ(water.cells_seen, quarter);
+  EXPECT_EQ(s.checked, 4 * quarter);
+  EXPECT_EQ(s.within, 3 * quarter);
+  EXPECT_EQ(s.cells_seen, 3 * quarter);
+  EXPECT_EQ(s.cells_covered, 2 * quarter);
+  EXPECT_NEAR(s.coverage, 2.0 / 3.0, 1e-12);
+
+  // Without a class raster, water counts like any other ground.
+  const SurfaceCheck plain = CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), Options());
+  EXPECT_TRUE(plain.by_class.empty());
+  EXPECT_EQ(plain.cells_seen, 4 * quarter);
+  EXPECT_EQ(plain.cells_covered, 3 * quarter);
+  // Nor when nothing is unmatchable.
+  o.unmatchable_classes.clear();
+  EXPECT_EQ(CheckAgainstSurface(cloud, FlatSurface(), NadirBlock(3), o).cells_seen, 4 * quarter);
+}
+
+TEST(CheckAgainstSurface, AClassRasterOffTheSurfaceGridThrows) {
+  const GeoRaster good = QuarterClasses();
+  GeoRaster shifted = good;
+  shifted.origin_x += kRasterCell;
+  GeoRaster coarser = good;
+  coarser.cell_size *= 2;
+  GeoRaster smaller = good;
+  smaller.width -= 1;
+  smaller.values.resize(static_cast<size_t>(smaller.width) * smaller.height);
+  for (const GeoRaster* bad : {&shifted, &coarser, &smaller}) {
+    SurfaceCheckOptions o = Options();
+    o.classes = bad;
+    EXPECT_THROW(CheckAgainstSurface(PointPerCell(), FlatSurface(), NadirBlock(3), o), Error);
+  }
+}
+
 }  // namespace sapmvs

@@ -64,18 +64,36 @@ struct MatcherOptions {
   double canny_low = 40;
   double canny_high = 120;
   bool use_edges = true;
+  // Expand-then-filter passes (PMVS: n = 3). Each pass after the first frees
+  // the cells of the points the filter removed and grows the surviving
+  // patches into them again.
+  int expand_iterations = 3;
   // Most candidate patches one device launch takes.
   int max_wave = 16384;
   // Waves stop after this many (0 = until the front is empty).
   int max_waves = 0;
+  // Score fence, in robust standard deviations (1.4826 x MAD): points of a
+  // patch scoring further than this below the median score of the first
+  // expansion's points go (0 = off). Most points are right, so their scores
+  // show what a right match scores on these images (their noise and
+  // texture): about 0.98 on the simulator's, 0.89 on NGI's scans; a fixed
+  // `threshold` (0.7, the floor) cannot be both.
+  double score_fence = 3.0;
   // Filtering: depth agreement tolerance, in pixel footprints.
   double depth_tolerance = 3.0;
   // Neighbourhood test: neighbours within this many footprints of a point.
   double neighbour_radius = 4.0;
-  // A point needs this many neighbours, and must lie within plane_tolerance
-  // footprints of the plane they fit.
+  // A point needs this many neighbours, and must lie within the plane
+  // tolerance of the plane they fit; a patch's plane must pass within it of
+  // most neighbouring points of other patches. The tolerance is
+  // plane_sigmas robust standard deviations of the distances between
+  // neighbouring patches (how noisy this group's depths are), and at least
+  // plane_tolerance footprints. Half a footprint (one full-resolution GSD at
+  // level 1): a fixed 1.5 let a quarter of the sapmvs points on
+  // `simulate --preset small` stray beyond 1 GSD.
   int min_neighbours = 4;
-  double plane_tolerance = 1.5;
+  double plane_tolerance = 0.5;
+  double plane_sigmas = 1.5;
   // Clusters (points linked within neighbour_radius) smaller than this are
   // removed.
   int min_cluster_size = 30;
@@ -121,6 +139,9 @@ struct MatchStats {
   long largest_wave = 0;
   std::map<int, long> accepted_by_size;  // sapmvs: patch side -> accepted patches
   long points_before_filter = 0;
+  double score_floor = 0;      // the score fence's value (>= threshold)
+  double plane_tolerance = 0;  // the neighbourhood test's, footprints (last pass)
+  long removed_score = 0;      // below score_floor
   long removed_visibility = 0;
   long removed_neighbourhood = 0;
   long removed_clusters = 0;

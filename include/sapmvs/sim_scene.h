@@ -15,6 +15,10 @@ namespace sapmvs::sim {
 
 enum class SurfaceClass : uint8_t { kGrass, kRoad, kSquare, kRoof, kTree, kWater, kBareSoil };
 
+// The ASPRS LAS code of a class: 2 ground, 5 high vegetation, 6 building,
+// 9 water (the LiDAR's classification and truth/classes.tif).
+uint8_t LasClass(SurfaceClass k);
+
 // What a scene holds and how dense it is. All lengths in metres.
 struct SceneSpec {
   double width = 400;                           // x extent

@@ -7,8 +7,14 @@
 //  - coverage: the ground is cut into cells of `cell_size`; a cell is "seen"
 //    when the surface at its centre projects into at least `min_images`
 //    images unoccluded (a ray march through the raster), and "covered" when
-//    it holds a point within `tolerance`.
+//    it holds a point within `tolerance`;
+//  - with a class raster (the simulator's truth/classes.tif, LAS codes), both
+//    split by class, and cells of an unmatchable class (water: no texture to
+//    match) are not counted as seen.
 #include <functional>
+#include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "sapmvs/block.h"
@@ -25,6 +31,17 @@ struct SurfaceCheckOptions {
   // it returns true count: to compare zones of one cloud, such as group
   // borders and group centres. Called concurrently.
   std::function<bool(double x, double y)> region;
+  // LAS class per cell on the surface's grid (same size and origin), or null.
+  const GeoRaster* classes = nullptr;
+  // Classes whose cells are never "seen": a matcher cannot be asked to cover
+  // them (LAS 9, water: flat colour the simulator gives no texture).
+  std::vector<int> unmatchable_classes = {9};
+};
+
+// The counts of SurfaceCheck for the points and cells of one class.
+struct ClassCheck {
+  long checked = 0, within = 0;
+  long cells_seen = 0, cells_covered = 0;
 };
 
 struct SurfaceCheck {
@@ -36,9 +53,17 @@ struct SurfaceCheck {
   long cells_seen = 0;
   long cells_covered = 0;
   double coverage = 0;  // covered / seen
+  // By LAS class, when SurfaceCheckOptions::classes is set; cells of an
+  // unmatchable class count their would-be seen cells here (not above).
+  std::map<int, ClassCheck> by_class;
 };
 
-// Throws Error for non-positive tolerance or cell size.
+// The simulator's class raster, classes.tif in the folder of `truth_path`
+// (its truth/dsm.tif), when there is one.
+std::optional<GeoRaster> ReadClassRasterBeside(const std::string& truth_path);
+
+// Throws Error for non-positive tolerance or cell size, or a class raster
+// not on the surface's grid.
 SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
                                  const Block& block, const SurfaceCheckOptions& options);
 

@@ -1,0 +1,205 @@
+#include "patch_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "sapmvs/camera.h"
+
+namespace sapmvs {
+namespace {
+
+// Nadir cameras 100 m above the ground z = 0 (local frame), 640 x 480 px,
+// f = 300 px: a footprint of 1/3 m on the ground.
+MatchGroupData NadirGroup(const std::vector<Eigen::Vector3d>& centers) {
+  Eigen::Matrix3d r_wc;
+  r_wc.row(0) = Eigen::Vector3d(1, 0, 0);
+  r_wc.row(1) = Eigen::Vector3d(0, -1, 0);
+  r_wc.row(2) = Eigen::Vector3d(0, 0, -1);
+  const Intrinsics k = Intrinsics::FromPixels(300, 300, 319.5, 239.5, 640, 480);
+  MatchGroupData group;
+  for (const Eigen::Vector3d& c : centers) {
+    MatchImage im;
+    im.camera = Camera(k, r_wc, c);
+    group.images.push_back(im);
+  }
+  return group;
+}
+
+struct Points {
+  std::vector<DensePoint> points;
+  std::vector<AcceptedPatch> patches;
+
+  // A point with a patch of its own.
+  int Add(const Eigen::Vector3d& x, int ref, std::vector<int> views, float score) {
+    AcceptedPatch p;
+    p.center = x;
+    p.ref = ref;
+    p.views = std::move(views);
+    p.score = score;
+    p.size = 7;
+    patches.push_back(p);
+    DensePoint d;
+    d.x = x;
+    d.patch = static_cast<int>(patches.size()) - 1;
+    points.push_back(d);
+    return static_cast<int>(points.size()) - 1;
+  }
+};
+
+// Images 0-2 above the origin match a point 10 m up in the air; images 3-6,
+// 60 m east, look past it at the ground 6.7 m west of the origin.
+class FreeSpaceTest : public ::testing::Test {
+ protected:
+  MatchGroupData group = NadirGroup({{-10, 0, 100},
+                                     {0, 0, 100},
+                                     {10, 0, 100},
+                                     {60, 0, 100},
+                                     {62, 0, 100},
+                                     {64, 0, 100},
+                                     {66, 0, 100}});
+  MatcherOptions options;
+  const Eigen::Vector3d floating{0, 0, 10};
+  // Where image 3's ray through `floating` meets the ground.
+  const Eigen::Vector3d behind{60 - 60 * 10.0 / 9.0, 0, 0};
+};
+
+TEST_F(FreeSpaceTest, APointThatAnotherImageSawTheGroundThroughGoes) {
+  Points p;
+  const int f = p.Add(floating, 0, {1, 2}, 0.9f);
+  p.Add(behind, 3, {4, 5, 6}, 0.95f);
+  ASSERT_LT(
+      (group.images[3].camera.Project(floating) - group.images[3].camera.Project(behind)).norm(),
+      1e-6);
+  EXPECT_FALSE(VisibilityFilter(group, options, p.points, p.patches)[f]);
+}
+
+TEST_F(FreeSpaceTest, WithoutTheGroundBehindItThePointStays) {
+  Points p;
+  const int f = p.Add(floating, 0, {1, 2}, 0.9f);
+  // The same ground point, seen only by images that do not see it behind
+  // the floating point... is not there: a point elsewhere.
+  p.Add(behind + Eigen::Vector3d(-20, 0, 0), 3, {4, 5, 6}, 0.95f);
+  EXPECT_TRUE(VisibilityFilter(group, options, p.points, p.patches)[f]);
+}
+
+TEST_F(FreeSpaceTest, ASurfaceInFrontOfThePointDoesNotRemoveIt) {
+  Points p;
+  const int f = p.Add(floating, 0, {1, 2}, 0.9f);
+  // Halfway between image 3 and the floating point: it hides the point in
+  // image 3, which proves nothing against it.
+  const Eigen::Vector3d in_front = 0.5 * (floating + group.images[3].camera.center());
+  p.Add(in_front, 3, {4, 5, 6}, 0.95f);
+  EXPECT_TRUE(VisibilityFilter(group, options, p.points, p.patches)[f]);
+}
+
+TEST_F(FreeSpaceTest, AWeakerGroundPointDoesNotOutvoteABetterSupportedOne) {
+  Points p;
+  // Support (1 + views) x score: 3 x 0.9 for the point, 2 x 0.75 for the
+  // ground seen through it.
+  const int f = p.Add(floating, 0, {1, 2}, 0.9f);
+  p.Add(behind, 3, {4}, 0.75f);
+  options.min_image_num = 2;
+  EXPECT_TRUE(VisibilityFilter(group, options, p.points, p.patches)[f]);
+}
+
+// A flat grid of points under images 0-2, every other one from a weak patch.
+Points GridWithWeakPatches(int* weak) {
+  Points p;
+  *weak = 0;
+  for (int r = 0; r < 40; ++r) {
+    for (int c = 0; c < 40; ++c) {
+      const bool low = (r + c) % 2 == 1;
+      p.Add(Eigen::Vector3d(-6 + 0.3 * c, -6 + 0.3 * r, 0), 0, {1, 2}, low ? 0.75f : 0.97f);
+      *weak += low;
+    }
+  }
+  return p;
+}
+
+TEST(FilterPoints, PointsBelowTheScoreFloorGoAndAreCounted) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  MatcherOptions options;
+  int weak = 0;
+  const Points p = GridWithWeakPatches(&weak);
+  MatchStats without;
+  const std::vector<bool> all = FilterPoints(group, options, p.points, p.patches, &without, 0.0);
+  EXPECT_EQ(without.removed_score, 0);
+  for (size_t i = 0; i < all.size(); ++i) EXPECT_TRUE(all[i]) << i;
+
+  MatchStats with;
+  const std::vector<bool> keep = FilterPoints(group, options, p.points, p.patches, &with, 0.9);
+  EXPECT_EQ(with.removed_score, weak);
+  EXPECT_EQ(with.removed_visibility + with.removed_neighbourhood + with.removed_clusters, 0);
+  for (size_t i = 0; i < keep.size(); ++i) {
+    EXPECT_EQ(keep[i], p.patches[p.points[i].patch].score >= 0.9f) << i;
+  }
+}
+
+TEST(FilterPoints, PointsBelowTheScoreFloorHideNothing) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  MatcherOptions options;
+  int weak = 0;
+  Points p = GridWithWeakPatches(&weak);
+  // A weak but many-viewed point 5 m above the grid's centre would hide the
+  // good points under it in every image if it took part.
+  for (int i = 0; i < 6; ++i) p.Add(Eigen::Vector3d(0.01 * i, 0, 5), 0, {1, 2}, 0.8f);
+  MatchStats with;
+  const std::vector<bool> keep = FilterPoints(group, options, p.points, p.patches, &with, 0.9);
+  EXPECT_EQ(with.removed_score, weak + 6);
+  long good = 0;
+  for (size_t i = 0; i < keep.size(); ++i) good += keep[i];
+  EXPECT_EQ(good, 40 * 40 - weak);
+}
+
+// A plane with depth noise of half a footprint (1/6 m) between patches, and
+// one patch 3 footprints above it.
+Points NoisyPlane(int* outlier) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.5 / 3.0);
+  Points p;
+  for (int r = 0; r < 41; ++r) {
+    for (int c = 0; c < 41; ++c) {
+      p.Add(Eigen::Vector3d(-6 + 0.3 * c, -6 + 0.3 * r, noise(rng)), 0, {1, 2}, 0.95f);
+    }
+  }
+  *outlier = p.Add(Eigen::Vector3d(0.05, 0.05, 1.0), 0, {1, 2}, 0.95f);
+  return p;
+}
+
+TEST(FilterPoints, ThePlaneToleranceFollowsTheNoiseBetweenPatches) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  int outlier = -1;
+  const Points p = NoisyPlane(&outlier);
+  auto kept_share = [&](const std::vector<bool>& keep) {
+    long n = 0;
+    for (size_t i = 0; i < keep.size(); ++i) n += keep[i] && static_cast<int>(i) != outlier;
+    return static_cast<double>(n) / (keep.size() - 1);
+  };
+  MatcherOptions fixed;
+  fixed.plane_sigmas = 0;
+  MatchStats fs;
+  const std::vector<bool> a = FilterPoints(group, fixed, p.points, p.patches, &fs);
+  EXPECT_EQ(fs.plane_tolerance, fixed.plane_tolerance);
+  MatcherOptions adaptive;
+  MatchStats as;
+  const std::vector<bool> b = FilterPoints(group, adaptive, p.points, p.patches, &as);
+  // The distance between two noisy patches is half-normal with sigma
+  // sqrt(2) / 6 m = 0.71 footprints, 1.5 of them 1.06; the nearest
+  // neighbours in 3D favour the closer depths, which takes a little off.
+  EXPECT_GT(as.plane_tolerance, 0.8);
+  EXPECT_LT(as.plane_tolerance, 1.5 * 0.5 * std::sqrt(2.0) + 0.1);
+  std::printf("[ filter   ] noisy plane: kept %.3f with 0.5 footprints, %.3f with %.2f\n",
+              kept_share(a), kept_share(b), as.plane_tolerance);
+  EXPECT_LT(kept_share(a), 0.8);
+  EXPECT_GT(kept_share(b), 0.9);
+  EXPECT_FALSE(a[outlier]);
+  EXPECT_FALSE(b[outlier]);
+}
+
+}  // namespace
+}  // namespace sapmvs
