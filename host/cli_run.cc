@@ -62,8 +62,9 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--expand-iterations", m.expand_iterations, "Expand-then-filter passes (PMVS: 3)")
       ->capture_default_str();
-  cmd->add_option("--score-fence", m.score_fence,
-                  "Filter: robust SDs below the seeds' median score a point may lie (0 = off)")
+  cmd->add_option(
+         "--score-fence", m.score_fence,
+         "Filter: robust SDs below the first pass's median score a point may lie (0 = off)")
       ->capture_default_str();
   cmd->add_option("--depth-tolerance", m.depth_tolerance,
                   "Filter: depth agreement, pixel footprints")

@@ -155,15 +155,20 @@ void ValidateNccBatch(const std::vector<NccPatch>& patches, const std::vector<Nc
   }
 }
 
+BuildOptions NccBuildOptions(int patch_size, int work_group_size) {
+  BuildOptions defines;
+  defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
+      .Define("PATCH_SIZE", patch_size)
+      .Define("WORK_GROUP_SIZE", work_group_size);
+  return defines;
+}
+
 NccScorer::NccScorer(ClContext& context, const NccScorerOptions& options)
     : context_(context), options_(options) {
   const std::string problem = OptionsProblem(options);
   if (!problem.empty()) throw Error("NccScorerOptions: expected " + problem);
-  BuildOptions defines;
-  defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
-      .Define("PATCH_SIZE", options.patch_size)
-      .Define("WORK_GROUP_SIZE", options.work_group_size);
-  const ClProgram& program = context_.Program(kKernelFile, defines);
+  const ClProgram& program =
+      context_.Program(kKernelFile, NccBuildOptions(options.patch_size, options.work_group_size));
   score_kernel_ = program.Kernel(kScoreKernel);
   probe_kernel_ = program.Kernel(kProbeKernel);
 }

@@ -72,6 +72,12 @@ static_assert(sizeof(NccPair) == sizeof(cl_int2), "NccPair is uploaded as int2")
 NccCamera MakeNccCamera(const Camera& local_camera, const char* what = "camera");
 NccPatch MakeNccPatch(const Eigen::Vector3d& center, const Eigen::Vector3d& normal, int reference);
 
+// The build options of every program that carries ncc_of (ncc_score.cl and
+// its verbatim copies in patch_refine.cl and roofline_probe.cl): the NCC's
+// variance floor, the patch side and the work-group size, so that the copies
+// are built alike.
+BuildOptions NccBuildOptions(int patch_size, int work_group_size);
+
 // ---------------------------------------------------------------------------
 
 struct NccScorerOptions {

@@ -165,42 +165,52 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   params.cores = 0;
   index.knnSearch(data, nn_m, nd_m, k, params);
 
-  // The plane tolerance, from how far the points of neighbouring patches lie
-  // from each other's planes: at least plane_tolerance footprints, else
+  // Distances, in footprints, from each patch's plane to the points of other
+  // patches among its points' neighbours (NaN for the other neighbours): the
+  // plane tolerance and test 2b below both come from them.
+  std::vector<float> radius(alive.size());
+  std::vector<float> foreign_distance(alive.size() * k, std::nanf(""));
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    const AcceptedPatch& patch = patches[p.patch];
+    const double fp = Footprint(group.images[patch.ref].camera, p.x);
+    radius[a] = static_cast<float>(options.neighbour_radius * fp);
+    for (int j = 0; j < k; ++j) {
+      const size_t b = nn[a * k + j];
+      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const DensePoint& q = points[alive[b]];
+      if (q.patch == p.patch) continue;
+      foreign_distance[a * k + j] =
+          static_cast<float>(std::abs(patch.normal.dot(q.x - patch.center)) / fp);
+    }
+  }
+  // The plane tolerance: at least plane_tolerance footprints, else
   // plane_sigmas robust standard deviations of those distances (1.4826 x
   // their median, as for half-normal residuals). Depth noise between patches
   // differs with texture and geometry (median 0.18 footprints on the
   // simulator's `small`, 0.43 on NGI's scans); one fixed tolerance either lets
   // roof planes stray over the ground on the one or strips the other.
-  std::vector<float> foreign_distance;
-  for (size_t a = 0; a < alive.size(); ++a) {
-    const DensePoint& p = points[alive[a]];
-    const AcceptedPatch& patch = patches[p.patch];
-    const double fp = Footprint(group.images[patch.ref].camera, p.x);
-    const double r = options.neighbour_radius * fp;
-    for (int j = 0; j < k; ++j) {
-      const size_t b = nn[a * k + j];
-      if (b == a || nd[a * k + j] > r * r || points[alive[b]].patch == p.patch) continue;
-      foreign_distance.push_back(
-          static_cast<float>(std::abs(patch.normal.dot(points[alive[b]].x - patch.center)) / fp));
-    }
-  }
   double tolerance = options.plane_tolerance;
-  if (!foreign_distance.empty()) {
-    auto mid = foreign_distance.begin() + foreign_distance.size() / 2;
-    std::nth_element(foreign_distance.begin(), mid, foreign_distance.end());
-    tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * *mid);
+  {
+    std::vector<float> d;
+    for (const float v : foreign_distance) {
+      if (!std::isnan(v)) d.push_back(v);
+    }
+    if (!d.empty()) {
+      auto mid = d.begin() + d.size() / 2;
+      std::nth_element(d.begin(), mid, d.end());
+      tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * *mid);
+    }
   }
   stats->plane_tolerance = tolerance;
 
   // 2. Neighbourhood and local plane.
-  std::vector<float> radius(alive.size());
   std::vector<uint8_t> pass(alive.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
     const double fp = Footprint(group.images[patches[p.patch].ref].camera, p.x);
-    radius[a] = static_cast<float>(options.neighbour_radius * fp);
     std::vector<Eigen::Vector3d> nbr;
     for (int j = 0; j < k; ++j) {
       const size_t b = nn[a * k + j];
@@ -224,18 +234,12 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // all, so a roof patch survives ground neighbours along its edge.
   std::vector<int> foreign(patches.size(), 0), consistent(patches.size(), 0);
   for (size_t a = 0; a < alive.size(); ++a) {
-    const DensePoint& p = points[alive[a]];
-    const AcceptedPatch& patch = patches[p.patch];
-    const double fp = Footprint(group.images[patch.ref].camera, p.x);
+    const int id = points[alive[a]].patch;
     for (int j = 0; j < k; ++j) {
-      const size_t b = nn[a * k + j];
-      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
-      const DensePoint& q = points[alive[b]];
-      if (q.patch == p.patch) continue;
-      ++foreign[p.patch];
-      if (std::abs(patch.normal.dot(q.x - patch.center)) <= tolerance * fp) {
-        ++consistent[p.patch];
-      }
+      const float d = foreign_distance[a * k + j];
+      if (std::isnan(d)) continue;
+      ++foreign[id];
+      if (d <= tolerance) ++consistent[id];
     }
   }
   auto supported = [&](int id) {

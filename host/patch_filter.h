@@ -28,9 +28,8 @@
 namespace sapmvs {
 
 // keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
-// filled. Points of
-// patches scoring below `score_floor` go first (removed_score) and take no
-// part in the other passes.
+// filled. Points of patches scoring below `score_floor` go first
+// (removed_score) and take no part in the other passes.
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,

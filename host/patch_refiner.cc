@@ -127,11 +127,8 @@ PatchRefiner::PatchRefiner(ClContext& context, const PatchRefinerOptions& option
     : context_(context), options_(options) {
   const std::string problem = OptionsProblem(options);
   if (!problem.empty()) throw Error("PatchRefinerOptions: expected " + problem);
-  BuildOptions defines;
-  defines.Define("MAX_VIEWS", kMaxViews)
-      .Define("NCC_MIN_VARIANCE", kNccMinVariance)
-      .Define("PATCH_SIZE", options.patch_size)
-      .Define("WORK_GROUP_SIZE", options.work_group_size);
+  BuildOptions defines = NccBuildOptions(options.patch_size, options.work_group_size);
+  defines.Define("MAX_VIEWS", kMaxViews);
   kernel_ = context_.Program(kKernelFile, defines).Kernel(kKernel);
 }
 

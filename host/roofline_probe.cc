@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ncc_scorer.h"
 #include "sapmvs/error.h"
 
 namespace sapmvs {
@@ -30,11 +31,8 @@ RooflineProbe::RooflineProbe(ClContext& context, const RooflineProbeOptions& opt
     : context_(context), options_(options) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("RooflineProbeOptions: expected " + problem);
-  BuildOptions defines;
-  defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
-      .Define("PATCH_SIZE", options.patch_size)
-      .Define("WORK_GROUP_SIZE", options.work_group_size);
-  const ClProgram& program = context_.Program(kKernelFile, defines);
+  const ClProgram& program =
+      context_.Program(kKernelFile, NccBuildOptions(options.patch_size, options.work_group_size));
   copy_kernel_ = program.Kernel("copy_float4");
   ncc_kernel_ = program.Kernel("ncc_window");
 }

@@ -24,6 +24,7 @@ uint8_t LasClass(SurfaceClass k) {
       return 2;
   }
 }
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
     // to be covered, and the rows split by class.
     const std::optional<GeoRaster> classes = ReadClassRasterBeside(truth_path);
     const double gsd = EstimateBlockGeometry(block).gsd_median;  // full resolution
+    const double coverage_cell = coverage_cells * base.cell_size * std::ldexp(1.0, level) * gsd;
     DeviceOptions dev;
     dev.device = device;
     dev.profile = true;
@@ -90,7 +91,7 @@ int main(int argc, char** argv) {
       row.points = r.stats.points;
       SurfaceCheckOptions so;
       so.tolerance = gsd;
-      so.cell_size = coverage_cells * o.cell_size * std::ldexp(1.0, level) * gsd;
+      so.cell_size = coverage_cell;
       if (classes) so.classes = &*classes;
       row.check = CheckAgainstSurface(r.cloud, truth, block, so);
       if (const char* dump = std::getenv("SAPMVS_DUMP_DZ")) {
@@ -112,8 +113,7 @@ int main(int argc, char** argv) {
                 << " below), plane tolerance " << r.stats.plane_tolerance << "\n";
     }
     std::cout << "block " << block_path << ", level " << level << ", GSD " << gsd
-              << " (tolerance 1 GSD; coverage cells of "
-              << coverage_cells * base.cell_size * std::ldexp(1.0, level) * gsd << ")\n";
+              << " (tolerance 1 GSD; coverage cells of " << coverage_cell << ")\n";
     std::cout << std::left << std::setw(8) << "mode" << std::right << std::setw(10) << "wall s"
               << std::setw(11) << "kernel s" << std::setw(10) << "points" << std::setw(12)
               << "<=1 GSD" << std::setw(12) << "median|dz|" << std::setw(11) << "coverage"
