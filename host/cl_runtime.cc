@@ -423,8 +423,11 @@ BuildOptions& BuildOptions::Define(const std::string& name, const std::string& v
 
 BuildOptions& BuildOptions::Define(const std::string& name, float value) {
   char text[32];
-  std::snprintf(text, sizeof(text), "%.9gf", static_cast<double>(value));
-  return Define(name, std::string(text));
+  std::snprintf(text, sizeof(text), "%.9g", static_cast<double>(value));
+  std::string literal(text);
+  // %g drops the point of whole numbers, and "15f" is not a C literal.
+  if (literal.find_first_of(".eEni") == std::string::npos) literal += ".0";
+  return Define(name, literal + "f");
 }
 
 std::string BuildOptions::Render() const {

@@ -47,6 +47,10 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   cmd->add_option("--adaptive-sizes", m.adaptive_sizes, "sapmvs patch sides, largest first")
       ->delimiter(',')
       ->capture_default_str();
+  cmd->add_option(
+         "--ncc-sigma-color", m.ncc_sigma_color,
+         "sapmvs: NCC sample weights, in SDs of the texture at the window's centre (0 = plain NCC)")
+      ->capture_default_str();
   cmd->add_option("--features-per-block", m.features_per_block,
                   "Features per detector per 32x32 block")
       ->capture_default_str();

@@ -64,6 +64,8 @@ std::string FirstProblem(const MatcherOptions& o) {
     s << "plane_sigmas >= 0";
   else if (!(o.score_fence >= 0))
     s << "score_fence >= 0";
+  else if (!(std::isfinite(o.ncc_sigma_color) && o.ncc_sigma_color >= 0))
+    s << "ncc_sigma_color finite and >= 0 (ncc_sigma_color = " << o.ncc_sigma_color << ")";
   else if (o.expand_iterations < 1 || o.expand_iterations > 10)
     s << "expand_iterations in 1..10";
   if (!s.str().empty()) return s.str();

@@ -34,6 +34,9 @@ std::string OptionsProblem(const NccScorerOptions& o) {
   if (o.work_group_size < 1) {
     return "work_group_size >= 1 (work_group_size = " + std::to_string(o.work_group_size) + ")";
   }
+  if (!(std::isfinite(o.sigma_color) && o.sigma_color >= 0.0)) {
+    return "sigma_color finite and >= 0 (sigma_color = " + std::to_string(o.sigma_color) + ")";
+  }
   return "";
 }
 
@@ -155,9 +158,10 @@ void ValidateNccBatch(const std::vector<NccPatch>& patches, const std::vector<Nc
   }
 }
 
-BuildOptions NccBuildOptions(int patch_size, int work_group_size) {
+BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color) {
   BuildOptions defines;
   defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
+      .Define("NCC_SIGMA_COLOR", static_cast<float>(sigma_color))
       .Define("PATCH_SIZE", patch_size)
       .Define("WORK_GROUP_SIZE", work_group_size);
   return defines;
@@ -167,8 +171,9 @@ NccScorer::NccScorer(ClContext& context, const NccScorerOptions& options)
     : context_(context), options_(options) {
   const std::string problem = OptionsProblem(options);
   if (!problem.empty()) throw Error("NccScorerOptions: expected " + problem);
-  const ClProgram& program =
-      context_.Program(kKernelFile, NccBuildOptions(options.patch_size, options.work_group_size));
+  const ClProgram& program = context_.Program(
+      kKernelFile,
+      NccBuildOptions(options.patch_size, options.work_group_size, options.sigma_color));
   score_kernel_ = program.Kernel(kScoreKernel);
   probe_kernel_ = program.Kernel(kProbeKernel);
 }
@@ -265,9 +270,10 @@ std::vector<float> NccScorer::ProbeSamples(int image, const std::vector<Eigen::V
 
 std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<NccPatch>& patches,
                                       const std::vector<NccPair>& pairs, int patch_size,
-                                      std::vector<double>* border_margin) {
+                                      std::vector<double>* border_margin, double sigma_color) {
   NccScorerOptions options;
   options.patch_size = patch_size;
+  options.sigma_color = sigma_color;
   const std::string problem = OptionsProblem(options);
   if (!problem.empty()) throw Error("NccScoreReference: expected " + problem);
   group.Validate();
@@ -277,11 +283,13 @@ std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<N
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const int half = patch_size / 2;
   const size_t num_samples = static_cast<size_t>(patch_size) * patch_size;
-  const double min_sum = static_cast<double>(kNccMinVariance) * static_cast<double>(num_samples);
+  // The kernel's sigma is a float literal.
+  const double sigma = static_cast<float>(sigma_color);
   std::vector<double> scores(pairs.size(), nan);
   if (border_margin != nullptr) border_margin->assign(pairs.size(), nan);
   std::vector<double> a(num_samples);
   std::vector<double> b(num_samples);
+  std::vector<double> weight(num_samples, 1.0);
 
   for (size_t i = 0; i < pairs.size(); ++i) {
     const NccPatch& patch = patches[pairs[i].patch];
@@ -324,22 +332,41 @@ std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<N
     if (border_margin != nullptr) (*border_margin)[i] = margin;
     if (!valid) continue;
 
+    if (sigma > 0.0) {
+      // Same weights as ncc_weights: the spread of the 3 x 3 samples around
+      // the centre, times sigma.
+      const size_t c = num_samples / 2;
+      double mean = 0.0, var = 0.0;
+      for (int r = -1; r <= 1; ++r)
+        for (int q = -1; q <= 1; ++q) mean += a[c + r * patch_size + q];
+      mean /= 9.0;
+      for (int r = -1; r <= 1; ++r)
+        for (int q = -1; q <= 1; ++q) var += std::pow(a[c + r * patch_size + q] - mean, 2);
+      const double s = sigma * std::sqrt(var / 9.0);
+      for (size_t k = 0; k < num_samples; ++k) {
+        const double d = a[k] - a[c];
+        weight[k] = s > 0.0 ? std::exp(-0.5 * (d * d) / (s * s)) : 1.0;
+      }
+    }
+    double sum_w = 0.0;
     double mean_a = 0.0;
     double mean_b = 0.0;
     for (size_t k = 0; k < num_samples; ++k) {
-      mean_a += a[k];
-      mean_b += b[k];
+      sum_w += weight[k];
+      mean_a += weight[k] * a[k];
+      mean_b += weight[k] * b[k];
     }
-    mean_a /= static_cast<double>(num_samples);
-    mean_b /= static_cast<double>(num_samples);
+    mean_a /= sum_w;
+    mean_b /= sum_w;
     double saa = 0.0;
     double sbb = 0.0;
     double sab = 0.0;
     for (size_t k = 0; k < num_samples; ++k) {
-      saa += (a[k] - mean_a) * (a[k] - mean_a);
-      sbb += (b[k] - mean_b) * (b[k] - mean_b);
-      sab += (a[k] - mean_a) * (b[k] - mean_b);
+      saa += weight[k] * (a[k] - mean_a) * (a[k] - mean_a);
+      sbb += weight[k] * (b[k] - mean_b) * (b[k] - mean_b);
+      sab += weight[k] * (a[k] - mean_a) * (b[k] - mean_b);
     }
+    const double min_sum = static_cast<double>(kNccMinVariance) * sum_w;
     if (!(saa >= min_sum && sbb >= min_sum)) continue;
     scores[i] = std::clamp(sab / std::sqrt(saa * sbb), -1.0, 1.0);
   }

@@ -74,9 +74,9 @@ NccPatch MakeNccPatch(const Eigen::Vector3d& center, const Eigen::Vector3d& norm
 
 // The build options of every program that carries ncc_of (ncc_score.cl and
 // its verbatim copies in patch_refine.cl and roofline_probe.cl): the NCC's
-// variance floor, the patch side and the work-group size, so that the copies
-// are built alike.
-BuildOptions NccBuildOptions(int patch_size, int work_group_size);
+// variance floor, the sample weights, the patch side and the work-group size,
+// so that the copies are built alike.
+BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color);
 
 // ---------------------------------------------------------------------------
 
@@ -87,6 +87,13 @@ struct NccScorerOptions {
   // Work-items per work-group, passed as -D WORK_GROUP_SIZE. Must be >= 1;
   // the device limits are checked at launch.
   int work_group_size = kDefaultWorkGroupSize;
+  // Sample weights, passed as -D NCC_SIGMA_COLOR: > 0 weights each sample by
+  // exp(-d^2 / 2 s^2), d its difference from the centre sample of the
+  // reference window and s = sigma_color standard deviations of the 3 x 3
+  // reference samples around the centre (the texture of the centre's
+  // surface), so that a window straddling two surfaces scores the one under
+  // its centre; 0 = plain NCC (PMVS). Finite, >= 0.
+  double sigma_color = 0.0;
 
   // Logs the first failing condition to stderr and returns false.
   bool Check() const;
@@ -161,9 +168,11 @@ void ValidateNccBatch(const std::vector<NccPatch>& patches, const std::vector<Nc
 // geometry and NaN rules. `border_margin`, if given, receives per pair the
 // smallest distance in pixels from any sample position to the edge of its
 // image's valid region (negative outside): where it is within float32 rounding
-// of 0 the kernel may legitimately decide the other way.
+// of 0 the kernel may legitimately decide the other way. `sigma_color`: as
+// NccScorerOptions::sigma_color.
 std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<NccPatch>& patches,
                                       const std::vector<NccPair>& pairs, int patch_size,
-                                      std::vector<double>* border_margin = nullptr);
+                                      std::vector<double>* border_margin = nullptr,
+                                      double sigma_color = 0.0);
 
 }  // namespace sapmvs

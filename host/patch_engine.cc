@@ -22,6 +22,11 @@ bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d
 
 }  // namespace
 
+double PatchEngine::SigmaColor() const {
+  if (options_.mode != MatchMode::kSapmvs) return 0.0;
+  return options_.ncc_sigma_color;
+}
+
 PatchEngine::PatchEngine(ClContext& context, const MatchGroupData& group,
                          const MatcherOptions& options)
     : context_(context), group_(group), options_(options) {
@@ -34,12 +39,14 @@ PatchEngine::PatchEngine(ClContext& context, const MatchGroupData& group,
     if (scorers_.count(size)) continue;
     NccScorerOptions so;
     so.patch_size = size;
+    so.sigma_color = SigmaColor();
     auto scorer = std::make_unique<NccScorer>(context_, so);
     scorer->UseGroup(device_group_);
     scorers_[size] = std::move(scorer);
   }
   PatchRefinerOptions ro;
   ro.patch_size = options_.window_size;
+  ro.sigma_color = SigmaColor();
   refiner_ = std::make_unique<PatchRefiner>(context_, ro);
   refiner_->UseGroup(device_group_, group_.ncc.cameras);
   if (options_.mode == MatchMode::kSapmvs) {
@@ -50,6 +57,7 @@ PatchEngine::PatchEngine(ClContext& context, const MatchGroupData& group,
       po.iterations = kPolishIterations;
       po.depth_step = kPolishDepthStep;
       po.angle_step_deg = kPolishAngleStepDeg;
+      po.sigma_color = SigmaColor();
       auto polisher = std::make_unique<PatchRefiner>(context_, po);
       polisher->UseGroup(device_group_, group_.ncc.cameras);
       polishers_[size] = std::move(polisher);

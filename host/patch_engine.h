@@ -67,6 +67,8 @@ class PatchEngine {
   const std::map<std::string, KernelTime>& kernel_times() const { return kernel_times_; }
 
  private:
+  // The NCC sample weights (MatcherOptions::ncc_sigma_color; 0 in pmvs mode).
+  double SigmaColor() const;
   bool OnParentPlane(const PatchCandidate& candidate, const Eigen::Vector3d& center) const;
   std::vector<int> VisibleViews(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
                                 int ref, int half) const;

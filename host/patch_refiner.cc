@@ -37,6 +37,9 @@ std::string OptionsProblem(const PatchRefinerOptions& o) {
   if (!(o.angle_step_deg > 0.0 && o.angle_step_deg <= 45.0)) {
     return "angle_step_deg in (0, 45] (angle_step_deg = " + std::to_string(o.angle_step_deg) + ")";
   }
+  if (!(std::isfinite(o.sigma_color) && o.sigma_color >= 0.0)) {
+    return "sigma_color finite and >= 0 (sigma_color = " + std::to_string(o.sigma_color) + ")";
+  }
   if (!(o.max_angle_deg > 0.0 && o.max_angle_deg <= 89.0)) {
     return "max_angle_deg in (0, 89] (max_angle_deg = " + std::to_string(o.max_angle_deg) + ")";
   }
@@ -127,7 +130,8 @@ PatchRefiner::PatchRefiner(ClContext& context, const PatchRefinerOptions& option
     : context_(context), options_(options) {
   const std::string problem = OptionsProblem(options);
   if (!problem.empty()) throw Error("PatchRefinerOptions: expected " + problem);
-  BuildOptions defines = NccBuildOptions(options.patch_size, options.work_group_size);
+  BuildOptions defines =
+      NccBuildOptions(options.patch_size, options.work_group_size, options.sigma_color);
   defines.Define("MAX_VIEWS", kMaxViews);
   kernel_ = context_.Program(kKernelFile, defines).Kernel(kKernel);
 }
@@ -230,7 +234,7 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
       if (!(std::abs(q[1]) <= max_angle && std::abs(q[2]) <= max_angle)) return nan;
       const Eigen::Vector3d n = f.Normal(q[1], q[2]);
       *nccs = NccScoreReference(group, {MakeNccPatch(f.origin + q[0] * f.ray, n, patch.reference)},
-                                pairs, options.patch_size);
+                                pairs, options.patch_size, nullptr, options.sigma_color);
       double sum = 0.0;
       for (double s : *nccs) {
         if (std::isnan(s)) return nan;

@@ -54,6 +54,9 @@ struct PatchRefinerOptions {
   double angle_step_deg = kDefaultRefineAngleStepDeg;
   // Largest |yaw| and |pitch| a candidate may have, in degrees; (0, 89].
   double max_angle_deg = kDefaultRefineMaxAngleDeg;
+  // Sample weights of the NCC (NccScorerOptions::sigma_color); finite, >= 0
+  // (0 = plain NCC).
+  double sigma_color = 0.0;
 
   // Logs the first failing condition to stderr and returns false.
   bool Check() const;

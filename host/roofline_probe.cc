@@ -31,8 +31,8 @@ RooflineProbe::RooflineProbe(ClContext& context, const RooflineProbeOptions& opt
     : context_(context), options_(options) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("RooflineProbeOptions: expected " + problem);
-  const ClProgram& program =
-      context_.Program(kKernelFile, NccBuildOptions(options.patch_size, options.work_group_size));
+  const ClProgram& program = context_.Program(
+      kKernelFile, NccBuildOptions(options.patch_size, options.work_group_size, 0.0));
   copy_kernel_ = program.Kernel("copy_float4");
   ncc_kernel_ = program.Kernel("ncc_window");
 }

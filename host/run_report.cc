@@ -27,6 +27,7 @@ nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
           {"view_angle_deg", m.view_angle_deg},
           {"window_size", m.window_size},
           {"adaptive_sizes", m.adaptive_sizes},
+          {"ncc_sigma_color", m.ncc_sigma_color},
           {"features_per_block", m.features_per_block},
           {"epipolar_distance", m.epipolar_distance},
           {"candidates_per_feature", m.candidates_per_feature},

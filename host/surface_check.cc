@@ -36,6 +36,60 @@ bool Occluded(const GeoRaster& r, const Eigen::Vector3d& p, const Eigen::Vector3
   return false;
 }
 
+// Images of `block` that see every point of `points` (in front, inside the
+// image, not hidden by the surface), counted up to `need`.
+int ViewsSeeingAll(const GeoRaster& surface, const std::vector<Eigen::Vector3d>& points,
+                   const Block& block, double top, int need) {
+  int views = 0;
+  for (const BlockImage& im : block.images) {
+    const Camera& cam = im.camera;
+    bool all = true;
+    for (const Eigen::Vector3d& p : points) {
+      if (!(cam.Depth(p) > 0) || !cam.InImage(cam.ProjectDistorted(p)) ||
+          Occluded(surface, p, cam.center(), top)) {
+        all = false;
+        break;
+      }
+    }
+    if (all && ++views >= need) break;
+  }
+  return views;
+}
+
+// Highest height of the surface.
+double SurfaceTop(const GeoRaster& surface) {
+  double top = -1e300;
+  for (size_t i = 0; i < surface.values.size(); ++i) {
+    if (std::isfinite(surface.values[i]) && surface.values[i] != surface.nodata) {
+      top = std::max(top, static_cast<double>(surface.values[i]));
+    }
+  }
+  return top;
+}
+
+// The check's cells over the surface: options.cell_size squares from the
+// surface's top-left corner, as many as fit.
+struct CheckGrid {
+  int cols = 0, rows = 0;
+  double x0 = 0, y0 = 0, cell = 0;
+  CheckGrid(const GeoRaster& surface, double cell_size)
+      : cols(static_cast<int>(std::floor(surface.width * surface.cell_size / cell_size))),
+        rows(static_cast<int>(std::floor(surface.height * surface.cell_size / cell_size))),
+        x0(surface.origin_x),
+        y0(surface.origin_y),
+        cell(cell_size) {}
+  double X(int c) const { return x0 + (c + 0.5) * cell; }
+  double Y(int r) const { return y0 - (r + 0.5) * cell; }
+};
+
+// Height of the surface at (x, y) when a cell centred there counts: inside
+// options.region (if set) and over a non-empty surface cell; NaN otherwise.
+double CountedHeight(const GeoRaster& surface, const SurfaceCheckOptions& options, double x,
+                     double y) {
+  if (options.region && !options.region(x, y)) return std::nan("");
+  return CellHeight(surface, x, y);
+}
+
 // LAS class of the cell under (x, y) of a raster on the surface's grid; -1
 // without one or outside.
 int CellClass(const GeoRaster* classes, double x, double y) {
@@ -69,11 +123,9 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
   }
   SurfaceCheck out;
   out.points = static_cast<long>(cloud.points.size());
-  const double x0 = surface.origin_x, y0 = surface.origin_y;
-  const int cols =
-      static_cast<int>(std::floor(surface.width * surface.cell_size / options.cell_size));
-  const int rows =
-      static_cast<int>(std::floor(surface.height * surface.cell_size / options.cell_size));
+  const CheckGrid grid(surface, options.cell_size);
+  const double x0 = grid.x0, y0 = grid.y0;
+  const int cols = grid.cols, rows = grid.rows;
   std::vector<uint8_t> covered(static_cast<size_t>(cols) * rows, 0);
   std::vector<double> abs_dz;
   for (const CloudPoint& p : cloud.points) {
@@ -97,30 +149,17 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
     std::nth_element(abs_dz.begin(), abs_dz.begin() + abs_dz.size() / 2, abs_dz.end());
     out.median_abs_dz = abs_dz[abs_dz.size() / 2];
   }
-  double top = -1e300;
-  for (size_t i = 0; i < surface.values.size(); ++i) {
-    if (std::isfinite(surface.values[i]) && surface.values[i] != surface.nodata) {
-      top = std::max(top, static_cast<double>(surface.values[i]));
-    }
-  }
+  const double top = SurfaceTop(surface);
   // Per coverage cell: -2 not seen, else its class (-1 without a raster).
   std::vector<int> seen_class(covered.size(), -2);
 #pragma omp parallel for schedule(dynamic, 8)
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
-      const double x = x0 + (c + 0.5) * options.cell_size;
-      const double y = y0 - (r + 0.5) * options.cell_size;
-      if (options.region && !options.region(x, y)) continue;
-      const double h = CellHeight(surface, x, y);
+      const double x = grid.X(c), y = grid.Y(r);
+      const double h = CountedHeight(surface, options, x, y);
       if (!std::isfinite(h)) continue;
-      const Eigen::Vector3d p(x, y, h);
-      int views = 0;
-      for (const BlockImage& im : block.images) {
-        const Camera& cam = im.camera;
-        if (!(cam.Depth(p) > 0) || !cam.InImage(cam.ProjectDistorted(p))) continue;
-        if (Occluded(surface, p, cam.center(), top)) continue;
-        if (++views >= options.min_images) break;
-      }
+      const int views =
+          ViewsSeeingAll(surface, {Eigen::Vector3d(x, y, h)}, block, top, options.min_images);
       if (views >= options.min_images) {
         seen_class[static_cast<size_t>(r) * cols + c] = CellClass(options.classes, x, y);
       }
@@ -143,6 +182,71 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
   out.cells_seen = seen;
   out.cells_covered = hit;
   out.coverage = seen > 0 ? static_cast<double>(hit) / seen : 0;
+  return out;
+}
+
+WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
+                                const SurfaceCheckOptions& options, double radius) {
+  if (!(options.tolerance > 0) || !(options.cell_size > 0) || !(radius > 0)) {
+    throw Error("window bound: tolerance, cell size and radius must be > 0");
+  }
+  const CheckGrid grid(surface, options.cell_size);
+  const double top = SurfaceTop(surface);
+  const auto& skip = options.unmatchable_classes;
+  // A window centred at (x, y): its 3 x 3 samples on the surface fit one
+  // plane (slopes from opposite samples) and are all seen by min_images
+  // images.
+  auto window_fits = [&](double x, double y) {
+    std::vector<Eigen::Vector3d> q;
+    for (int j = -1; j <= 1; ++j) {
+      for (int i = -1; i <= 1; ++i) {
+        const double h = CellHeight(surface, x + i * radius, y + j * radius);
+        if (!std::isfinite(h)) return false;
+        q.emplace_back(x + i * radius, y + j * radius, h);
+      }
+    }
+    const double zc = q[4].z();
+    const double sx = (q[5].z() - q[3].z()) / (2 * radius);
+    const double sy = (q[7].z() - q[1].z()) / (2 * radius);
+    for (const Eigen::Vector3d& p : q) {
+      if (std::abs(p.z() - (zc + sx * (p.x() - x) + sy * (p.y() - y))) > options.tolerance) {
+        return false;
+      }
+    }
+    return ViewsSeeingAll(surface, q, block, top, options.min_images) >= options.min_images;
+  };
+  long seen = 0, centred = 0, any_window = 0;
+#pragma omp parallel for schedule(dynamic, 8) reduction(+ : seen, centred, any_window)
+  for (int r = 0; r < grid.rows; ++r) {
+    for (int c = 0; c < grid.cols; ++c) {
+      const double x = grid.X(c), y = grid.Y(r);
+      const double h = CountedHeight(surface, options, x, y);
+      if (!std::isfinite(h)) continue;
+      const int k = CellClass(options.classes, x, y);
+      if (k >= 0 && std::find(skip.begin(), skip.end(), k) != skip.end()) continue;
+      if (ViewsSeeingAll(surface, {Eigen::Vector3d(x, y, h)}, block, top, options.min_images) <
+          options.min_images) {
+        continue;
+      }
+      ++seen;
+      if (window_fits(x, y)) {
+        ++centred;
+        ++any_window;
+        continue;
+      }
+      bool any = false;
+      for (int j = -1; j <= 1 && !any; ++j) {
+        for (int i = -1; i <= 1 && !any; ++i) {
+          if (i != 0 || j != 0) any = window_fits(x + i * radius, y + j * radius);
+        }
+      }
+      any_window += any;
+    }
+  }
+  WindowBound out;
+  out.cells_seen = seen;
+  out.centred = centred;
+  out.any = any_window;
   return out;
 }
 

@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
   std::string only;
   MatcherOptions base;
   app.add_option("--only", only, "Run one mode: sapmvs or pmvs");
+  bool window_bound = false;
+  app.add_flag("--window-bound", window_bound,
+               "Also print the coverage a window matcher could reach at all "
+               "(WindowCoverageBound, half-width wsize/2 working pixels)");
   app.add_option("--threshold", base.threshold, "MatcherOptions::threshold");
   app.add_option("--view-angle", base.view_angle_deg, "MatcherOptions::view_angle_deg");
   app.add_option("--min-image-num", base.min_image_num, "MatcherOptions::min_image_num");
@@ -54,6 +58,9 @@ int main(int argc, char** argv) {
   app.add_option("--score-fence", base.score_fence, "MatcherOptions::score_fence");
   app.add_option("--expand-iterations", base.expand_iterations,
                  "MatcherOptions::expand_iterations");
+  app.add_option("--ncc-sigma-color", base.ncc_sigma_color, "MatcherOptions::ncc_sigma_color");
+  app.add_option("--wsize", base.window_size, "MatcherOptions::window_size");
+  app.add_option("--csize", base.cell_size, "MatcherOptions::cell_size");
   app.add_option("--adaptive-sizes", base.adaptive_sizes, "MatcherOptions::adaptive_sizes")
       ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
@@ -139,6 +146,20 @@ int main(int argc, char** argv) {
                     << "% covered\n";
         }
       }
+    }
+    if (window_bound) {
+      SurfaceCheckOptions so;
+      so.tolerance = gsd;
+      so.cell_size = coverage_cell;
+      if (classes) so.classes = &*classes;
+      const double radius = (base.window_size / 2) * std::ldexp(1.0, level) * gsd;
+      const WindowBound b = WindowCoverageBound(truth, block, so, radius);
+      std::cout << std::setprecision(1) << "window bound (" << base.window_size << "x"
+                << base.window_size << ", half-width " << std::setprecision(2) << radius << "): of "
+                << b.cells_seen << " seen cells, a window centred there fits "
+                << std::setprecision(1) << 100.0 * b.centred / std::max(1L, b.cells_seen)
+                << "%, one containing the cell " << 100.0 * b.any / std::max(1L, b.cells_seen)
+                << "%\n";
     }
     if (rows.size() == 2) {
       const Row& p = rows[0];

@@ -214,6 +214,11 @@ TEST(ClDevicesTest, ListingFindsPoclCpuDevice) {
 TEST(ClBuildOptionsTest, RenderedSortedWithStandard) {
   const BuildOptions options{{"WORK_GROUP_SIZE", "64"}, {"MAX_VIEWS", "8"}};
   EXPECT_EQ(options.Render(), "-cl-std=CL1.2 -D MAX_VIEWS=8 -D WORK_GROUP_SIZE=64");
+  // Floats are C float literals, whole numbers included ("15f" is not one).
+  EXPECT_EQ(BuildOptions().Define("S", 15.0f).Render(), "-cl-std=CL1.2 -D S=15.0f");
+  EXPECT_EQ(BuildOptions().Define("S", 0.0f).Render(), "-cl-std=CL1.2 -D S=0.0f");
+  EXPECT_EQ(BuildOptions().Define("S", 0.25f).Render(), "-cl-std=CL1.2 -D S=0.25f");
+  EXPECT_EQ(BuildOptions().Define("S", 1e-4f).Render(), "-cl-std=CL1.2 -D S=9.99999975e-05f");
   EXPECT_EQ(BuildOptions().Define("B", 2).Define("A", 1).Render(),
             BuildOptions().Define("A", 1).Define("B", 2).Render());
   EXPECT_THROW(BuildOptions().Define("1X", 1), std::invalid_argument);

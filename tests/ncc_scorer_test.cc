@@ -120,15 +120,20 @@ struct ScoreCase {
   int width;
   int height;
   uint32_t seed;
+  double sigma_color = 0.0;
 };
 
 void PrintTo(const ScoreCase& c, std::ostream* out) {
-  *out << "patch " << c.patch_size << ", " << c.width << "x" << c.height << ", seed " << c.seed;
+  *out << "patch " << c.patch_size << ", " << c.width << "x" << c.height << ", seed " << c.seed
+       << ", sigma_color " << c.sigma_color;
 }
 
 std::string CaseName(const ::testing::TestParamInfo<ScoreCase>& info) {
   return "patch" + std::to_string(info.param.patch_size) + "_" + std::to_string(info.param.width) +
-         "x" + std::to_string(info.param.height);
+         "x" + std::to_string(info.param.height) +
+         (info.param.sigma_color > 0
+              ? "_sigma" + std::to_string(static_cast<int>(info.param.sigma_color))
+              : "");
 }
 
 class NccScorerCaseTest : public ClTest, public ::testing::WithParamInterface<ScoreCase> {};
@@ -142,16 +147,18 @@ TEST_P(NccScorerCaseTest, MatchesDoubleReference) {
 
   NccScorerOptions options;
   options.patch_size = c.patch_size;
+  options.sigma_color = c.sigma_color;
   NccScorer scorer(context(), options);
   scorer.SetGroup(scene.group);
   const std::vector<float> scores = scorer.Score(patches, pairs);
   std::vector<double> margin;
   const std::vector<double> expected =
-      NccScoreReference(scene.group, patches, pairs, c.patch_size, &margin);
+      NccScoreReference(scene.group, patches, pairs, c.patch_size, &margin, c.sigma_color);
   const Comparison result = CompareWithReference(scores, expected, margin);
-  std::printf("[ NCC      ] patch %d: %d valid, %d NaN, %d ambiguous, worst |error| %.3g\n",
-              c.patch_size, result.num_valid, result.num_nan, result.num_ambiguous,
-              result.worst_error);
+  std::printf(
+      "[ NCC      ] patch %d, sigma %g: %d valid, %d NaN, %d ambiguous, worst |error| %.3g\n",
+      c.patch_size, c.sigma_color, result.num_valid, result.num_nan, result.num_ambiguous,
+      result.worst_error);
   // Both outcomes exercised, and border ambiguity stays rare.
   EXPECT_GT(result.num_valid, static_cast<int>(pairs.size()) / 4);
   EXPECT_GT(result.num_nan, static_cast<int>(pairs.size()) / 10);
@@ -161,7 +168,12 @@ TEST_P(NccScorerCaseTest, MatchesDoubleReference) {
 INSTANTIATE_TEST_SUITE_P(NccSizes, NccScorerCaseTest,
                          ::testing::Values(ScoreCase{5, 161, 123, 31}, ScoreCase{7, 161, 123, 32},
                                            ScoreCase{11, 161, 123, 33}, ScoreCase{7, 97, 211, 34},
-                                           ScoreCase{11, 255, 101, 35}),
+                                           ScoreCase{11, 255, 101, 35},
+                                           // Sample weights: the matcher's default and
+                                           // narrower.
+                                           ScoreCase{7, 161, 123, 36, 3.0},
+                                           ScoreCase{5, 97, 211, 37, 1.0},
+                                           ScoreCase{15, 201, 161, 38, 3.0}),
                          CaseName);
 
 class NccScorerTest : public ClTest {};
@@ -218,6 +230,58 @@ TEST_F(NccScorerTest, TruePatchScoresHighAndOffsetPatchLow) {
   // The reference pairs with itself: NCC 1.
   const std::vector<float> self = scorer.Score(patches, {{0, 0}});
   EXPECT_NEAR(self[0], 1.0f, 1e-5f);
+}
+
+// A window whose right two columns lie, in the reference, on another
+// surface (a bright roof edge overhanging the ground there, which the views
+// see further right): plain NCC fails on the ground the centre lies on; with
+// sample weights the bright columns drop out and the ground matches.
+TEST_F(NccScorerTest, SampleWeightsScoreTheSurfaceUnderTheCentre) {
+  PlaneScene scene = MakePlaneScene(4, 161, 123, 81);
+  const Camera& ref = scene.cameras[0];
+  const double edge = 80.25;  // reference column where the other surface starts
+  const int width = 161, height = 123;
+  std::mt19937 rng(82);
+  std::uniform_real_distribution<float> noise(-20.0f, 20.0f);
+  for (int i = 0; i < 4; ++i) {
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const Eigen::Vector2d uv(u, v);
+        // The views see the other surface only 3 reference columns further on.
+        const double u_ref = i == 0 ? u : ref.Project(GroundAt(scene.cameras[i], uv)).x();
+        if (u_ref > edge + (i == 0 ? 0.0 : 3.0)) {
+          scene.pixels[i][static_cast<size_t>(v) * width + u] = 240.0f + noise(rng);
+        }
+      }
+    }
+  }
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  for (const double v : {40.0, 60.0, 80.0}) {
+    patches.push_back(
+        MakeNccPatch(GroundAt(ref, Eigen::Vector2d(79, v)), Eigen::Vector3d::UnitZ(), 0));
+    for (int view = 1; view < 4; ++view)
+      pairs.push_back({static_cast<int>(patches.size()) - 1, view});
+  }
+  NccScorerOptions plain_options;
+  NccScorerOptions weighted_options;
+  weighted_options.sigma_color = 3.0;
+  NccScorer plain(context(), plain_options);
+  NccScorer weighted(context(), weighted_options);
+  plain.SetGroup(scene.group);
+  weighted.SetGroup(scene.group);
+  const std::vector<float> p = plain.Score(patches, pairs);
+  const std::vector<float> w = weighted.Score(patches, pairs);
+  const std::vector<double> expected =
+      NccScoreReference(scene.group, patches, pairs, kDefaultPatchSize, nullptr, 3.0);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    std::printf("[ NCC      ] pair %zu: plain %.3f, weighted %.3f\n", i, p[i], w[i]);
+    // Measured: plain -0.33 to 0.42, weighted 0.64 to 0.97.
+    EXPECT_LT(p[i], 0.5) << "pair " << i;
+    EXPECT_GT(w[i], 0.6) << "pair " << i;
+    EXPECT_GT(w[i], p[i] + 0.4) << "pair " << i;
+    EXPECT_TRUE(NearAbsRel(w[i], expected[i], kAbsTol, kRelTol)) << "pair " << i;
+  }
 }
 
 TEST_F(NccScorerTest, FlatImageAndBehindCameraGiveNaN) {
@@ -341,6 +405,14 @@ TEST_F(NccScorerTest, RejectsBadInputBeforeEnqueue) {
   options.work_group_size = 0;
   EXPECT_FALSE(options.Check());
   EXPECT_THROW(NccScorer(context(), options), Error);
+  for (double sigma : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    NccScorerOptions weights;
+    weights.sigma_color = sigma;
+    EXPECT_FALSE(weights.Check()) << sigma;
+    EXPECT_THROW(NccScoreReference(MakePlaneScene(2, 31, 21, 81).group, {}, {}, 7, nullptr, sigma),
+                 Error)
+        << sigma;
+  }
 
   PlaneScene scene = MakePlaneScene(2, 31, 21, 81);
   NccScorer scorer(context());

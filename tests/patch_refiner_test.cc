@@ -244,6 +244,49 @@ TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
   }
 }
 
+// Sample weights (sigma_color 3, the matcher's default): the weighted search
+// takes the reference's path where its decisions are clear, and converges to
+// the plane as the plain one does (ConvergesToThePlaneAndMatchesReference).
+TEST_F(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 12, 2.5, 15.0, 52, &patches, &views);
+  PatchRefinerOptions options;
+  options.patch_size = 11;
+  options.sigma_color = 3.0;
+  options.iterations = 4;
+  PatchRefiner short_refiner(context(), options);
+  short_refiner.SetGroup(scene.group);
+  const RefComparison s =
+      CompareWithReference(short_refiner.Refine(patches, views),
+                           PatchRefineReference(scene.group, patches, views, options));
+  options.iterations = kDefaultRefineIterations;
+  PatchRefiner refiner(context(), options);
+  refiner.SetGroup(scene.group);
+  const std::vector<RefinedPatch> refined = refiner.Refine(patches, views);
+  const RefComparison c =
+      CompareWithReference(refined, PatchRefineReference(scene.group, patches, views, options));
+  std::printf(
+      "[ REFINE   ] weighted: 4 iterations %d/%zu same-path; %d iterations worst score error "
+      "%.3g\n",
+      s.same_path, patches.size(), options.iterations, c.worst_score_error);
+  EXPECT_GE(s.same_path, static_cast<int>(patches.size()) / 2);
+  const Camera& ref = scene.cameras[0];
+  for (size_t i = 0; i < refined.size(); ++i) {
+    const RefinedPatch& r = refined[i];
+    const Eigen::Vector3d center(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
+    const Eigen::Vector3d ray = (center - ref.center()).normalized();
+    const double depth_error = std::abs(center.z() / ray.z()) / Footprint(ref, center);
+    std::printf("[ REFINE   ] weighted patch %zu: depth error %.3f footprints, score %.4f\n", i,
+                depth_error, r.score);
+    EXPECT_LT(depth_error, 0.5) << "patch " << i;
+    EXPECT_GT(r.score, 0.9) << "patch " << i;
+  }
+  options.sigma_color = -1.0;
+  EXPECT_FALSE(options.Check());
+}
+
 TEST_F(PatchRefinerTest, RejectsInvalidInputsBeforeEnqueue) {
   const PlaneScene scene = MakePlaneScene(4, 97, 81, 71);
   PatchRefiner refiner(context());

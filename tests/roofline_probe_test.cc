@@ -89,7 +89,9 @@ TEST(RooflineProbeKernelText, NccIsAVerbatimCopyOfTheScoringKernels) {
   const size_t a0 = ncc.find(begin), b0 = probe.find(begin);
   ASSERT_NE(a0, std::string::npos);
   ASSERT_NE(b0, std::string::npos);
-  const size_t a1 = ncc.find("\n}\n", a0), b1 = probe.find("\n}\n", b0);
+  // Through the end of ncc_weights, which follows ncc_of.
+  const size_t a1 = ncc.find("\n}\n", ncc.find("void ncc_weights(", a0));
+  const size_t b1 = probe.find("\n}\n", probe.find("void ncc_weights(", b0));
   ASSERT_NE(a1, std::string::npos);
   ASSERT_NE(b1, std::string::npos);
   EXPECT_EQ(ncc.substr(a0, a1 - a0), probe.substr(b0, b1 - b0));

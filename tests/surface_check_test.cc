@@ -301,4 +301,42 @@ TEST(CheckAgainstSurface, AClassRasterOffTheSurfaceGridThrows) {
   }
 }
 
+// Flat: every window lies on one plane, so only the raster's border matters.
+// With a half-width of 1.5 the outermost ring of check cells (centres 1 from
+// the edge) has no centred window inside the raster, but one shifted inwards.
+TEST(WindowCoverageBound, OnAFlatSurfaceOnlyTheBorderRingNeedsAShift) {
+  const WindowBound b = WindowCoverageBound(FlatSurface(), NadirBlock(3), Options(), 1.5);
+  EXPECT_EQ(b.cells_seen, kCheckCells * kCheckCells);
+  EXPECT_EQ(b.centred, (kCheckCells - 2) * (kCheckCells - 2));
+  EXPECT_EQ(b.any, kCheckCells * kCheckCells);
+}
+
+// A 5-high box on 10 x 10 check cells: a window centred on the ring of
+// cells either side of its edge (44 outside, 36 on top) straddles the step;
+// one shifted away from the edge fits, where the ground beside the box is
+// seen whole from 3 images.
+TEST(WindowCoverageBound, WindowsStraddlingAStepDoNotFitButShiftedOnesDo) {
+  GeoRaster box = FlatSurface();
+  for (int r = 0; r < kRasterCells; ++r) {
+    for (int c = 0; c < kRasterCells; ++c) {
+      const double x = kX0 + (c + 0.5) * kRasterCell, y = kY0 - (r + 0.5) * kRasterCell;
+      if (x > 1040 && x < 1060 && y > 2040 && y < 2060) {
+        box.values[static_cast<size_t>(r) * kRasterCells + c] = static_cast<float>(kZ + 5);
+      }
+    }
+  }
+  const Block block = NadirBlock(3);
+  const WindowBound flat = WindowCoverageBound(FlatSurface(), block, Options(), 1.5);
+  const WindowBound b = WindowCoverageBound(box, block, Options(), 1.5);
+  // The box hides little ground from cameras 100 above its middle, so almost
+  // every cell stays seen (the check's own count).
+  const SurfaceCheck s = CheckAgainstSurface(PointPerCell(), box, block, Options());
+  EXPECT_EQ(b.cells_seen, s.cells_seen);
+  EXPECT_GE(b.cells_seen, flat.cells_seen - 44);
+  EXPECT_LE(b.centred, flat.centred - 80);
+  EXPECT_GE(b.any - b.centred, 60);
+  EXPECT_LE(b.any, b.cells_seen);
+  EXPECT_THROW(WindowCoverageBound(box, block, Options(), 0.0), Error);
+}
+
 }  // namespace sapmvs

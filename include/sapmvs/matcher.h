@@ -53,6 +53,17 @@ struct MatcherOptions {
   // Self-adaptive patch sides tried in order, pixels, odd, decreasing, each
   // <= kMaxPatchSize; the last must equal window_size (sapmvs mode).
   std::vector<int> adaptive_sizes = {21, 15, 11, 7};
+  // sapmvs: NCC sample weights. Each sample of a window counts
+  // exp(-d^2 / 2 s^2), d its difference from the window's centre sample in
+  // the reference image and s this many standard deviations of the 3 x 3
+  // samples around the centre, so that a window straddling a wall, a roof
+  // edge or a crown scores the surface under its centre rather than failing
+  // or settling on a depth between the two. Relative, so one value suits
+  // scans and renderings of any contrast; smaller is sharper at edges but
+  // noisier on weak texture (on `small`, 1.5: 73.0 % coverage; 3: 72.4 %;
+  // NGI keeps 87 % of its points at 3, 76 % at 2). 0 = plain NCC; pmvs mode
+  // always scores plain NCC, as PMVS does.
+  double ncc_sigma_color = 3.0;
   // Features kept per detector per 32 x 32 pixel block (PMVS: 4).
   int features_per_block = 4;
   // Candidate matches lie within this many pixels of the epipolar line.

@@ -62,6 +62,23 @@ struct SurfaceCheck {
 // (its truth/dsm.tif), when there is one.
 std::optional<GeoRaster> ReadClassRasterBeside(const std::string& truth_path);
 
+// What a window matcher could cover at all, on CheckAgainstSurface's cells:
+// of the cells seen in min_images images (unmatchable classes left out), those
+// with a square window of half-width `radius` on the true surface, centred
+// on the cell (`centred`) or on the cell shifted by `radius` along x, y or
+// both (`any`), whose 3 x 3 samples fit one plane within `tolerance` and are
+// all seen by the same min_images images. A matcher that keeps only its
+// windows' centres (PMVS) cannot cover more than `centred`, one that keeps
+// whole windows (SAPMVS) not more than `any` (up to the 3 x 3 sampling).
+struct WindowBound {
+  long cells_seen = 0;
+  long centred = 0;
+  long any = 0;
+};
+// Throws Error for non-positive tolerance, cell size or radius.
+WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
+                                const SurfaceCheckOptions& options, double radius);
+
 // Throws Error for non-positive tolerance or cell size, or a class raster
 // not on the surface's grid.
 SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
