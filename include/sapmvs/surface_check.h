@@ -68,8 +68,10 @@ std::optional<GeoRaster> ReadClassRasterBeside(const std::string& truth_path);
 // on the cell (`centred`) or on the cell shifted by `radius` along x, y or
 // both (`any`), whose 3 x 3 samples fit one plane within `tolerance` and are
 // all seen by the same min_images images. A matcher that keeps only its
-// windows' centres (PMVS) cannot cover more than `centred`, one that keeps
-// whole windows (SAPMVS) not more than `any` (up to the 3 x 3 sampling).
+// windows' centres (PMVS, with check cells of one matcher cell) covers about
+// `centred` at most (its centres may sit anywhere in the cell, not only at
+// the cell's centre); one that keeps whole windows (SAPMVS) about `any` (up
+// to the 3 x 3 sampling).
 struct WindowBound {
   long cells_seen = 0;
   long centred = 0;
