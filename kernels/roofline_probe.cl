@@ -69,8 +69,9 @@ float ncc_of(const float* a, const float* b, const float* w) {
 
 // The weights of the reference samples `a`: 1 each when NCC_SIGMA_COLOR is
 // 0, else exp(-d^2 / 2 s^2) for d the sample's difference from the centre
-// sample and s = NCC_SIGMA_COLOR standard deviations of `a` (relative, so
-// that one setting suits dim scans and bright renderings alike). A window
+// sample and s = NCC_SIGMA_COLOR standard deviations of the 3 x 3 samples
+// around the centre (relative, so that one setting suits dim scans and bright
+// renderings alike). A window
 // that straddles a wall or a roof edge then scores the surface under its
 // centre more than the mixture. A flat window keeps weights 1 (and gets NaN
 // from ncc_of's variance floor). native_exp (core OpenCL, not an extension):
