@@ -60,6 +60,10 @@ int main(int argc, char** argv) {
                  "MatcherOptions::expand_iterations");
   app.add_option("--ncc-sigma-color", base.ncc_sigma_color, "MatcherOptions::ncc_sigma_color");
   app.add_option("--wsize", base.window_size, "MatcherOptions::window_size");
+  app.add_option("--features-per-block", base.features_per_block,
+                 "MatcherOptions::features_per_block");
+  app.add_option("--candidates", base.candidates_per_feature,
+                 "MatcherOptions::candidates_per_feature");
   app.add_option("--csize", base.cell_size, "MatcherOptions::cell_size");
   app.add_option("--adaptive-sizes", base.adaptive_sizes, "MatcherOptions::adaptive_sizes")
       ->delimiter(',');
