@@ -80,6 +80,13 @@ struct CheckGrid {
         cell(cell_size) {}
   double X(int c) const { return x0 + (c + 0.5) * cell; }
   double Y(int r) const { return y0 - (r + 0.5) * cell; }
+  // Index of the cell under (x, y); -1 outside the grid.
+  long Index(double x, double y) const {
+    const int c = static_cast<int>(std::floor((x - x0) / cell));
+    const int r = static_cast<int>(std::floor((y0 - y) / cell));
+    if (c < 0 || r < 0 || c >= cols || r >= rows) return -1;
+    return static_cast<long>(r) * cols + c;
+  }
 };
 
 // Height of the surface at (x, y) when a cell centred there counts: inside
@@ -98,16 +105,14 @@ int CellClass(const GeoRaster* classes, double x, double y) {
   return std::isfinite(v) ? static_cast<int>(std::lround(v)) : -1;
 }
 
-}  // namespace
-
-std::optional<GeoRaster> ReadClassRasterBeside(const std::string& truth_path) {
-  const auto path = std::filesystem::path(truth_path).parent_path() / "classes.tif";
-  if (!std::filesystem::exists(path)) return std::nullopt;
-  return ReadGeoRaster(path);
+bool Unmatchable(const SurfaceCheckOptions& options, int k) {
+  const auto& skip = options.unmatchable_classes;
+  return std::find(skip.begin(), skip.end(), k) != skip.end();
 }
 
-SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
-                                 const Block& block, const SurfaceCheckOptions& options) {
+// Throws Error for non-positive tolerance or cell size, or a class raster
+// not on the surface's grid.
+void ValidateOptions(const GeoRaster& surface, const SurfaceCheckOptions& options) {
   if (!(options.tolerance > 0) || !(options.cell_size > 0)) {
     throw Error("surface check: tolerance and cell size must be > 0");
   }
@@ -121,12 +126,38 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
                   " cells of the same size and origin)");
     }
   }
+}
+
+// The check cell centred at (x, y): kNotSeen unless it counts (region,
+// surface) and min_images images see its centre, else its class (-1 without
+// a class raster).
+constexpr int kNotSeen = -2;
+int SeenClass(const GeoRaster& surface, const Block& block, const SurfaceCheckOptions& options,
+              double top, double x, double y) {
+  const double h = CountedHeight(surface, options, x, y);
+  if (!std::isfinite(h)) return kNotSeen;
+  if (ViewsSeeingAll(surface, {Eigen::Vector3d(x, y, h)}, block, top, options.min_images) <
+      options.min_images) {
+    return kNotSeen;
+  }
+  return CellClass(options.classes, x, y);
+}
+
+}  // namespace
+
+std::optional<GeoRaster> ReadClassRasterBeside(const std::string& truth_path) {
+  const auto path = std::filesystem::path(truth_path).parent_path() / "classes.tif";
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  return ReadGeoRaster(path);
+}
+
+SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
+                                 const Block& block, const SurfaceCheckOptions& options) {
+  ValidateOptions(surface, options);
   SurfaceCheck out;
   out.points = static_cast<long>(cloud.points.size());
   const CheckGrid grid(surface, options.cell_size);
-  const double x0 = grid.x0, y0 = grid.y0;
-  const int cols = grid.cols, rows = grid.rows;
-  std::vector<uint8_t> covered(static_cast<size_t>(cols) * rows, 0);
+  std::vector<uint8_t> covered(static_cast<size_t>(grid.cols) * grid.rows, 0);
   std::vector<double> abs_dz;
   for (const CloudPoint& p : cloud.points) {
     if (options.region && !options.region(p.position.x(), p.position.y())) continue;
@@ -140,9 +171,8 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
     if (dz > options.tolerance) continue;
     ++out.within;
     if (k >= 0) ++out.by_class[k].within;
-    const int c = static_cast<int>(std::floor((p.position.x() - x0) / options.cell_size));
-    const int r = static_cast<int>(std::floor((y0 - p.position.y()) / options.cell_size));
-    if (c >= 0 && r >= 0 && c < cols && r < rows) covered[static_cast<size_t>(r) * cols + c] = 1;
+    const long cell = grid.Index(p.position.x(), p.position.y());
+    if (cell >= 0) covered[static_cast<size_t>(cell)] = 1;
   }
   if (out.checked > 0) {
     out.share_within = static_cast<double>(out.within) / out.checked;
@@ -150,31 +180,24 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
     out.median_abs_dz = abs_dz[abs_dz.size() / 2];
   }
   const double top = SurfaceTop(surface);
-  // Per coverage cell: -2 not seen, else its class (-1 without a raster).
-  std::vector<int> seen_class(covered.size(), -2);
+  // Per coverage cell: kNotSeen, or its class.
+  std::vector<int> seen_class(covered.size(), kNotSeen);
 #pragma omp parallel for schedule(dynamic, 8)
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      const double x = grid.X(c), y = grid.Y(r);
-      const double h = CountedHeight(surface, options, x, y);
-      if (!std::isfinite(h)) continue;
-      const int views =
-          ViewsSeeingAll(surface, {Eigen::Vector3d(x, y, h)}, block, top, options.min_images);
-      if (views >= options.min_images) {
-        seen_class[static_cast<size_t>(r) * cols + c] = CellClass(options.classes, x, y);
-      }
+  for (int r = 0; r < grid.rows; ++r) {
+    for (int c = 0; c < grid.cols; ++c) {
+      seen_class[static_cast<size_t>(r) * grid.cols + c] =
+          SeenClass(surface, block, options, top, grid.X(c), grid.Y(r));
     }
   }
   long seen = 0, hit = 0;
   for (size_t i = 0; i < seen_class.size(); ++i) {
     const int k = seen_class[i];
-    if (k == -2) continue;
+    if (k == kNotSeen) continue;
     if (k >= 0) {
       ClassCheck& cc = out.by_class[k];
       ++cc.cells_seen;
       if (covered[i]) ++cc.cells_covered;
-      const auto& skip = options.unmatchable_classes;
-      if (std::find(skip.begin(), skip.end(), k) != skip.end()) continue;
+      if (Unmatchable(options, k)) continue;
     }
     ++seen;
     if (covered[i]) ++hit;
@@ -187,12 +210,10 @@ SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surfa
 
 WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
                                 const SurfaceCheckOptions& options, double radius) {
-  if (!(options.tolerance > 0) || !(options.cell_size > 0) || !(radius > 0)) {
-    throw Error("window bound: tolerance, cell size and radius must be > 0");
-  }
+  ValidateOptions(surface, options);
+  if (!(radius > 0)) throw Error("window bound: radius must be > 0");
   const CheckGrid grid(surface, options.cell_size);
   const double top = SurfaceTop(surface);
-  const auto& skip = options.unmatchable_classes;
   // A window centred at (x, y): its 3 x 3 samples on the surface fit one
   // plane (slopes from opposite samples) and are all seen by min_images
   // images.
@@ -220,14 +241,8 @@ WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
   for (int r = 0; r < grid.rows; ++r) {
     for (int c = 0; c < grid.cols; ++c) {
       const double x = grid.X(c), y = grid.Y(r);
-      const double h = CountedHeight(surface, options, x, y);
-      if (!std::isfinite(h)) continue;
-      const int k = CellClass(options.classes, x, y);
-      if (k >= 0 && std::find(skip.begin(), skip.end(), k) != skip.end()) continue;
-      if (ViewsSeeingAll(surface, {Eigen::Vector3d(x, y, h)}, block, top, options.min_images) <
-          options.min_images) {
-        continue;
-      }
+      const int k = SeenClass(surface, block, options, top, x, y);
+      if (k == kNotSeen || (k >= 0 && Unmatchable(options, k))) continue;
       ++seen;
       if (window_fits(x, y)) {
         ++centred;

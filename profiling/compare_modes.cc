@@ -76,6 +76,10 @@ int main(int argc, char** argv) {
     const std::optional<GeoRaster> classes = ReadClassRasterBeside(truth_path);
     const double gsd = EstimateBlockGeometry(block).gsd_median;  // full resolution
     const double coverage_cell = coverage_cells * base.cell_size * std::ldexp(1.0, level) * gsd;
+    SurfaceCheckOptions so;
+    so.tolerance = gsd;
+    so.cell_size = coverage_cell;
+    if (classes) so.classes = &*classes;
     DeviceOptions dev;
     dev.device = device;
     dev.profile = true;
@@ -100,10 +104,6 @@ int main(int argc, char** argv) {
       row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       for (const auto& [name, t] : r.stats.kernels) row.kernel_seconds += t.seconds;
       row.points = r.stats.points;
-      SurfaceCheckOptions so;
-      so.tolerance = gsd;
-      so.cell_size = coverage_cell;
-      if (classes) so.classes = &*classes;
       row.check = CheckAgainstSurface(r.cloud, truth, block, so);
       if (const char* dump = std::getenv("SAPMVS_DUMP_DZ")) {
         std::ofstream d(std::string(dump) + "_" + row.mode + ".txt");
@@ -152,10 +152,6 @@ int main(int argc, char** argv) {
       }
     }
     if (window_bound) {
-      SurfaceCheckOptions so;
-      so.tolerance = gsd;
-      so.cell_size = coverage_cell;
-      if (classes) so.classes = &*classes;
       const double radius = (base.window_size / 2) * std::ldexp(1.0, level) * gsd;
       const WindowBound b = WindowCoverageBound(truth, block, so, radius);
       std::cout << std::setprecision(1) << "window bound (" << base.window_size << "x"

@@ -149,7 +149,30 @@ TEST(PatchRefineKernelTextTest, NccHelpersAreVerbatimCopies) {
   EXPECT_NE(refine.find(camera), std::string::npos);
 }
 
-class PatchRefinerTest : public ClTest {};
+// Distance of a refined centre to the plane z = 0 along the reference ray, in
+// footprints of the reference camera.
+double DepthErrorFootprints(const Camera& ref, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ray = (c - ref.center()).normalized();
+  return std::abs(c.z() / ray.z()) / Footprint(ref, c);
+}
+
+class PatchRefinerTest : public ClTest {
+ protected:
+  // Refines on the device with `options` and compares with the reference;
+  // `refined`, if given, receives the device's patches.
+  RefComparison RefineAndCompare(const PlaneScene& scene, const std::vector<NccPatch>& patches,
+                                 const std::vector<std::vector<int>>& views,
+                                 const PatchRefinerOptions& options,
+                                 std::vector<RefinedPatch>* refined = nullptr) {
+    PatchRefiner refiner(context(), options);
+    refiner.SetGroup(scene.group);
+    std::vector<RefinedPatch> got = refiner.Refine(patches, views);
+    const RefComparison c =
+        CompareWithReference(got, PatchRefineReference(scene.group, patches, views, options));
+    if (refined != nullptr) *refined = std::move(got);
+    return c;
+  }
+};
 
 TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
   const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
@@ -162,9 +185,8 @@ TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
   // up to 5.2 degrees off its normal. 11x11 pins the normal to 2.4 degrees.
   PatchRefinerOptions options;
   options.patch_size = 11;
-  PatchRefiner refiner(context(), options);
-  refiner.SetGroup(scene.group);
-  const std::vector<RefinedPatch> refined = refiner.Refine(patches, views);
+  std::vector<RefinedPatch> refined;
+  const RefComparison vs = RefineAndCompare(scene, patches, views, options, &refined);
   ASSERT_EQ(refined.size(), patches.size());
   const Camera& ref = scene.cameras[0];
   double worst_depth = 0.0;
@@ -175,9 +197,7 @@ TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
                             refined[i].patch.center.s[2]);
     const Eigen::Vector3d n(refined[i].patch.normal.s[0], refined[i].patch.normal.s[1],
                             refined[i].patch.normal.s[2]);
-    // Distance to the plane z = 0 along the reference ray, in footprints.
-    const Eigen::Vector3d ray = (c - ref.center()).normalized();
-    const double depth_error = std::abs(c.z() / ray.z()) / Footprint(ref, c);
+    const double depth_error = DepthErrorFootprints(ref, c);
     const double angle_error = AngleDeg(n, Eigen::Vector3d::UnitZ());
     EXPECT_LT(depth_error, 0.5) << "patch " << i;
     EXPECT_LT(angle_error, 5.0) << "patch " << i;
@@ -191,15 +211,12 @@ TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
     worst_angle = std::max(worst_angle, angle_error);
     lowest_score = std::min(lowest_score, static_cast<double>(refined[i].score));
   }
-  const std::vector<RefinedPatchReference> expected =
-      PatchRefineReference(scene.group, patches, views, options);
-  const RefComparison c = CompareWithReference(refined, expected);
   std::printf(
       "[ REFINE   ] %zu patches: worst depth error %.3f footprints, worst normal error %.2f deg, "
       "lowest score %.4f; vs reference: worst score error %.3g, %d same-path (worst depth %.3g "
       "fp, angle %.3g rad)\n",
-      refined.size(), worst_depth, worst_angle, lowest_score, c.worst_score_error, c.same_path,
-      c.worst_depth_error, c.worst_angle_error);
+      refined.size(), worst_depth, worst_angle, lowest_score, vs.worst_score_error, vs.same_path,
+      vs.worst_depth_error, vs.worst_angle_error);
 }
 
 TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
@@ -210,21 +227,13 @@ TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
   PatchRefinerOptions options;
   options.patch_size = 5;
   options.iterations = 12;
-  PatchRefiner refiner(context(), options);
-  refiner.SetGroup(scene.group);
-  const std::vector<RefinedPatch> refined = refiner.Refine(patches, views);
-  const RefComparison c =
-      CompareWithReference(refined, PatchRefineReference(scene.group, patches, views, options));
+  const RefComparison c = RefineAndCompare(scene, patches, views, options);
   std::printf("[ REFINE   ] harder: worst score error %.3g, %d/%zu same-path\n",
               c.worst_score_error, c.same_path, patches.size());
   // Few iterations: the steps stay large, so the decision margins do too and
   // most searches must take the reference's exact path.
   options.iterations = 4;
-  PatchRefiner short_refiner(context(), options);
-  short_refiner.SetGroup(scene.group);
-  const RefComparison s =
-      CompareWithReference(short_refiner.Refine(patches, views),
-                           PatchRefineReference(scene.group, patches, views, options));
+  const RefComparison s = RefineAndCompare(scene, patches, views, options);
   std::printf(
       "[ REFINE   ] 4 iterations: worst score error %.3g, %d/%zu same-path (worst depth %.3g "
       "fp, angle %.3g rad)\n",
@@ -256,17 +265,10 @@ TEST_F(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
   options.patch_size = 11;
   options.sigma_color = 3.0;
   options.iterations = 4;
-  PatchRefiner short_refiner(context(), options);
-  short_refiner.SetGroup(scene.group);
-  const RefComparison s =
-      CompareWithReference(short_refiner.Refine(patches, views),
-                           PatchRefineReference(scene.group, patches, views, options));
+  const RefComparison s = RefineAndCompare(scene, patches, views, options);
   options.iterations = kDefaultRefineIterations;
-  PatchRefiner refiner(context(), options);
-  refiner.SetGroup(scene.group);
-  const std::vector<RefinedPatch> refined = refiner.Refine(patches, views);
-  const RefComparison c =
-      CompareWithReference(refined, PatchRefineReference(scene.group, patches, views, options));
+  std::vector<RefinedPatch> refined;
+  const RefComparison c = RefineAndCompare(scene, patches, views, options, &refined);
   std::printf(
       "[ REFINE   ] weighted: 4 iterations %d/%zu same-path; %d iterations worst score error "
       "%.3g\n",
@@ -276,8 +278,7 @@ TEST_F(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
   for (size_t i = 0; i < refined.size(); ++i) {
     const RefinedPatch& r = refined[i];
     const Eigen::Vector3d center(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
-    const Eigen::Vector3d ray = (center - ref.center()).normalized();
-    const double depth_error = std::abs(center.z() / ray.z()) / Footprint(ref, center);
+    const double depth_error = DepthErrorFootprints(ref, center);
     std::printf("[ REFINE   ] weighted patch %zu: depth error %.3f footprints, score %.4f\n", i,
                 depth_error, r.score);
     EXPECT_LT(depth_error, 0.5) << "patch " << i;

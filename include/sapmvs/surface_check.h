@@ -77,7 +77,8 @@ struct WindowBound {
   long centred = 0;
   long any = 0;
 };
-// Throws Error for non-positive tolerance, cell size or radius.
+// Throws Error for non-positive tolerance, cell size or radius, or a class
+// raster not on the surface's grid.
 WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
                                 const SurfaceCheckOptions& options, double radius);
 
