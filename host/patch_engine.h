@@ -7,14 +7,18 @@
 // In sapmvs mode an accepted patch is then scored at the adaptive sizes,
 // largest first (21, 15, 11, 7), each size one launch for the whole batch,
 // and takes the largest size at which it still passes. Each size first
-// polishes the patch at that size (a short refinement with small steps, one
-// launch per size): the 7 x 7 window constrains the normal too loosely to
-// extrapolate it over 21 pixels. A size is only taken when, in addition, the
-// polished plane scores >= threshold in each of the 8 window_size sub-windows
-// along the patch border (corners and edge midpoints): a large window that
-// straddles a roof edge passes on its dominant part alone, and would emit
-// roof-height points over the ground beside it (on the city preset the test
-// raised the share within 1 m of the LiDAR from 54.5 % to 70.8 %).
+// polishes the patch at that size (a short refinement, one launch per size):
+// the 7 x 7 window constrains the normal too loosely to extrapolate it over
+// 21 pixels. Only patches whose unpolished plane already reaches
+// threshold_before at that size, over the window and in its border
+// sub-windows, are polished (PMVS's rule before optimisation; it skips about
+// two thirds of the polishing, which most large patches fail anyway). A size
+// is only taken when, in addition, the polished plane scores >= threshold in
+// each of the 8 window_size sub-windows along the patch border (corners and
+// edge midpoints): a large window that straddles a roof edge passes on its
+// dominant part alone, and would emit roof-height points over the ground
+// beside it (on the city preset the test raised the share within 1 m of the
+// LiDAR from 54.5 % to 70.8 %).
 #include <Eigen/Core>
 #include <map>
 #include <memory>
@@ -67,6 +71,21 @@ class PatchEngine {
   const std::map<std::string, KernelTime>& kernel_times() const { return kernel_times_; }
 
  private:
+  // A plane tried at a larger patch size, with the views it is scored in.
+  struct LargePlane {
+    Eigen::Vector3d center, normal;
+    int ref;
+    const std::vector<int>* views;
+  };
+  // Per plane: whether each of the 8 window_size sub-windows at the corners
+  // and edge midpoints of a size x size patch scores >= threshold, averaged
+  // over the plane's views (sub-windows without texture count as fitting).
+  std::vector<bool> CornersFit(int size, const std::vector<LargePlane>& planes, double threshold);
+  // The patches of `open` (indices into `results`) worth polishing at
+  // `size`, with the views to polish each with; the others go to `rejected`.
+  std::vector<int> WorthPolishing(int size, const std::vector<int>& open,
+                                  const std::vector<std::optional<AcceptedPatch>>& results,
+                                  std::vector<std::vector<int>>* views, std::vector<int>* rejected);
   // The NCC sample weights (MatcherOptions::ncc_sigma_color; 0 in pmvs mode).
   double SigmaColor() const;
   bool OnParentPlane(const PatchCandidate& candidate, const Eigen::Vector3d& center) const;

@@ -163,7 +163,12 @@ void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
       offer(Eigen::Vector2d((nx + 0.5) * cs - 0.5, (ny + 0.5) * cs - 0.5));
     }
   } else {
-    const int step = patch.size / 2 + 1 + hw;
+    // The paper's "just beyond its extent": the new centre two pixels past
+    // the parent's edge, its window overlapping the parent's last pixels.
+    // Centring the new window wholly beyond the parent (a step longer by
+    // hw - 1) left the ground between a patch and a wall or crown untried
+    // (`small` at level 0: 85.6 % of the seen cells covered against 87.1 %).
+    const int step = patch.size / 2 + 2;
     const Eigen::Vector2d c(std::round(uv0.x()), std::round(uv0.y()));
     for (const auto& d : kDirections8) offer(c + step * Eigen::Vector2d(d[0], d[1]));
   }

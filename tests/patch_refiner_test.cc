@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -50,27 +49,14 @@ double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
   return (camera.rotation() * (x - camera.center())).z() / camera.intrinsics().MeanFocal();
 }
 
-// Patches on the ground under pixels near the centre of image 0, started
-// `depth_offsets` footprints off along the ray and `tilt_deg` off in normal
-// (about a horizontal axis that turns with the patch index).
+// Patches on the ground near the centre of image 0 (test::PerturbedStarts),
+// each matched with the three other images.
 void PerturbedPatches(const PlaneScene& scene, int num_patches, double depth_offset,
                       double tilt_deg, uint32_t seed, std::vector<NccPatch>* patches,
                       std::vector<std::vector<int>>* views) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const Camera& ref = scene.cameras[0];
-  for (int p = 0; p < num_patches; ++p) {
-    const Eigen::Vector2d uv(0.5 * (ref.width() - 1) + 20.0 * unit(rng),
-                             0.5 * (ref.height() - 1) + 15.0 * unit(rng));
-    const Eigen::Vector3d truth = GroundAt(ref, uv);
-    const Eigen::Vector3d ray = (truth - ref.center()).normalized();
-    const double sign = (p % 2 == 0) ? 1.0 : -1.0;
-    const Eigen::Vector3d start = truth + sign * depth_offset * Footprint(ref, truth) * ray;
-    const double azimuth = 2.0 * kPiRad * p / num_patches;
-    const Eigen::Vector3d axis(std::cos(azimuth), std::sin(azimuth), 0.0);
-    const Eigen::Vector3d normal =
-        Eigen::AngleAxisd(tilt_deg * kPiRad / 180.0, axis) * Eigen::Vector3d::UnitZ();
-    patches->push_back(MakeNccPatch(start, normal, 0));
+  for (const test::PlaneStart& s :
+       test::PerturbedStarts(scene, num_patches, depth_offset, tilt_deg, {20.0, 15.0}, seed)) {
+    patches->push_back(MakeNccPatch(s.center, s.normal, 0));
     views->push_back({1, 2, 3});
   }
 }

@@ -60,4 +60,28 @@ Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv) {
   return camera.center() - (camera.center().z() / d.z()) * d;
 }
 
+std::vector<PlaneStart> PerturbedStarts(const PlaneScene& scene, int count, double depth_offset,
+                                        double tilt_deg, const Eigen::Vector2d& spread,
+                                        uint32_t seed) {
+  constexpr double kPi = 3.14159265358979323846;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const Camera& ref = scene.cameras[0];
+  std::vector<PlaneStart> starts;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector2d uv(0.5 * (ref.width() - 1) + spread.x() * unit(rng),
+                             0.5 * (ref.height() - 1) + spread.y() * unit(rng));
+    const Eigen::Vector3d truth = GroundAt(ref, uv);
+    const Eigen::Vector3d ray = (truth - ref.center()).normalized();
+    const double footprint = ref.Depth(truth) / ref.intrinsics().MeanFocal();
+    const double sign = (i % 2 == 0) ? 1.0 : -1.0;
+    const double azimuth = 2.0 * kPi * i / count;
+    const Eigen::Vector3d axis(std::cos(azimuth), std::sin(azimuth), 0.0);
+    starts.push_back(
+        PlaneStart{truth + sign * depth_offset * footprint * ray,
+                   Eigen::AngleAxisd(tilt_deg * kPi / 180.0, axis) * Eigen::Vector3d::UnitZ()});
+  }
+  return starts;
+}
+
 }  // namespace sapmvs::test

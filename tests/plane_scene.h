@@ -35,4 +35,17 @@ PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed);
 // Ground point (z = 0) seen at pixel `uv` of `camera`.
 Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv);
 
+// A plane to start a refinement from.
+struct PlaneStart {
+  Eigen::Vector3d center, normal;
+};
+
+// `count` starts on the ground under random pixels of image 0 within
+// `spread` (x, y) pixels of its centre, `depth_offset` footprints off along
+// the ray (alternately in front and behind) and `tilt_deg` off in normal,
+// about a horizontal axis that turns with the start's index.
+std::vector<PlaneStart> PerturbedStarts(const PlaneScene& scene, int count, double depth_offset,
+                                        double tilt_deg, const Eigen::Vector2d& spread,
+                                        uint32_t seed);
+
 }  // namespace sapmvs::test
