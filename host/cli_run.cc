@@ -19,6 +19,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   auto strategy = std::make_shared<std::string>("strip");
   auto budget = std::make_shared<std::string>("8G");
   auto profile = std::make_shared<std::string>();
+  auto block_flags = std::make_shared<BlockFlags>();
   MatcherOptions& m = o->matcher;
   CLI::App* cmd = app.add_subcommand(
       "run", "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json");
@@ -26,6 +27,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
                   "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
       ->required();
   cmd->add_option("--out", o->out, "Output folder")->required();
+  AddBlockFlags(cmd, block_flags.get());
   cmd->add_option("--mode", *mode, "sapmvs (self-adaptive patch) or pmvs")->capture_default_str();
   cmd->add_option("--device", o->device,
                   "OpenCL device: index or name substring (see `sapmvs devices`)");
@@ -109,23 +111,27 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
                       "Profile the kernels and phases: print tables, write FILE (CSV) and its "
                       ".json (default DIR/profile.csv)")
           ->expected(0, 1);
-  cmd->callback([o, mode, no_edges, strategy, budget, profile, profile_option, &global] {
-    o->profile = profile_option->count() > 0;
-    o->grouping.strategy = ParseGroupingStrategy(*strategy);
-    o->grouping.memory_budget = ParseByteSize(*budget);
-    o->matcher.mode = ParseMatchMode(*mode);
-    o->matcher.use_edges = !*no_edges;
-    o->matcher.progress = !global.quiet;
-    const RunReport report = RunDense(*o);
-    PrintRunSummary(report, std::cout);
-    if (o->profile) {
-      PrintProfile(report, std::cout);
-      const std::filesystem::path csv =
-          profile->empty() ? o->out / "profile.csv" : std::filesystem::path(*profile);
-      WriteProfile(report, csv);
-      std::cout << "profile       " << csv.string() << " (and .json)\n";
-    }
-  });
+  cmd->callback(
+      [o, block_flags, mode, no_edges, strategy, budget, profile, profile_option, &global] {
+        o->read = block_flags->read;
+        o->read.format = ParseBlockFormat(block_flags->format);
+        o->ground_height = block_flags->ground_height;
+        o->profile = profile_option->count() > 0;
+        o->grouping.strategy = ParseGroupingStrategy(*strategy);
+        o->grouping.memory_budget = ParseByteSize(*budget);
+        o->matcher.mode = ParseMatchMode(*mode);
+        o->matcher.use_edges = !*no_edges;
+        o->matcher.progress = !global.quiet;
+        const RunReport report = RunDense(*o);
+        PrintRunSummary(report, std::cout);
+        if (o->profile) {
+          PrintProfile(report, std::cout);
+          const std::filesystem::path csv =
+              profile->empty() ? o->out / "profile.csv" : std::filesystem::path(*profile);
+          WriteProfile(report, csv);
+          std::cout << "profile       " << csv.string() << " (and .json)\n";
+        }
+      });
 }
 
 }  // namespace sapmvs::cli

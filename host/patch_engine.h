@@ -12,7 +12,7 @@
 // 21 pixels. Only patches whose unpolished plane already reaches
 // threshold_before at that size, over the window and in its border
 // sub-windows, are polished (PMVS's rule before optimisation; it skips about
-// two thirds of the polishing, which most large patches fail anyway). A size
+// three quarters of the polishing, which most large patches fail anyway). A size
 // is only taken when, in addition, the polished plane scores >= threshold in
 // each of the 8 window_size sub-windows along the patch border (corners and
 // edge midpoints): a large window that straddles a roof edge passes on its

@@ -170,6 +170,36 @@ TEST_F(CliRunTest, NegativeLevelIsOneLineNamingIt) {
   EXPECT_TRUE(NoOutput());
 }
 
+// --format, --image-dir, --no-size-check and --ground-height are info's
+// block flags, and reach the reader: an empty image folder fails naming it,
+// an unknown format or an infinite height fails naming the value, and the
+// block's own folder given explicitly (with its format) runs.
+TEST_F(CliRunTest, TakesInfosBlockFlags) {
+  const fs::path empty = *root_ / "empty_images";
+  fs::create_directories(empty);
+  const std::string run = "run " + Block().string() + " --out " + out_.string();
+  const auto no_images = RunCli(run + " --image-dir " + empty.string());
+  EXPECT_NE(no_images.exit_code, 0);
+  EXPECT_EQ(test::CountLines(no_images.err), 1) << no_images.err;
+  EXPECT_NE(no_images.err.find(empty.string()), std::string::npos) << no_images.err;
+  EXPECT_TRUE(NoOutput());
+  const auto bad_format = RunCli(run + " --format bogus");
+  EXPECT_NE(bad_format.exit_code, 0);
+  EXPECT_EQ(test::CountLines(bad_format.err), 1) << bad_format.err;
+  EXPECT_NE(bad_format.err.find("bogus"), std::string::npos) << bad_format.err;
+  EXPECT_TRUE(NoOutput());
+  const auto bad_height = RunCli(run + " --ground-height inf");
+  EXPECT_NE(bad_height.exit_code, 0);
+  EXPECT_EQ(test::CountLines(bad_height.err), 1) << bad_height.err;
+  EXPECT_NE(bad_height.err.find("ground height"), std::string::npos) << bad_height.err;
+  EXPECT_TRUE(NoOutput());
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto r = RunCli(run + " --format yaml --image-dir " +
+                        (Block().parent_path() / "images").string() + " --no-size-check -q");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out_ / "cloud.ply"));
+}
+
 TEST_F(CliRunTest, ProfilePrintsKernelTablesAndWritesThem) {
   if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
   const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " --profile -q");

@@ -13,9 +13,11 @@
 // was never interrupted.
 #include <filesystem>
 #include <iosfwd>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "sapmvs/block_reader.h"
 #include "sapmvs/cloud_dsm.h"
 #include "sapmvs/cloud_merge.h"
 #include "sapmvs/grouping.h"
@@ -25,7 +27,12 @@ namespace sapmvs {
 
 struct RunOptions {
   std::filesystem::path block;  // any format ReadBlock takes
-  std::filesystem::path out;    // output folder, created when missing
+  // How to read it (format, image folder, image size check).
+  BlockReadOptions read;
+  // Mean ground height, block units, for blocks that carry no surface
+  // estimate (NaN = the block's own).
+  double ground_height = std::numeric_limits<double>::quiet_NaN();
+  std::filesystem::path out;  // output folder, created when missing
   // OpenCL device: index or name substring ("" = SAPMVS_DEVICE, else the default).
   std::string device;
   MatcherOptions matcher;
