@@ -486,7 +486,7 @@ const ClProgram& ClContext::CachedProgram(std::string_view name, const BuildOpti
   }
   std::string loaded;
   if (!source) {
-    loaded = KernelSource(name);
+    loaded = ProgramSource(name);
     source = loaded;
   }
   CacheEntry entry;

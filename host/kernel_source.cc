@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "sapmvs/embedded_kernels.h"
@@ -10,6 +11,8 @@
 
 namespace sapmvs {
 namespace {
+
+constexpr int kMaxIncludeDepth = 8;
 
 std::string AvailableFiles() {
   std::string list;
@@ -50,5 +53,43 @@ std::string KernelSource(std::string_view file) {
   text << stream.rdbuf();
   return text.str();
 }
+
+namespace {
+
+std::string ExpandIncludes(std::string_view file, int depth) {
+  static const std::regex kInclude(R"re(^\s*#\s*include\s*"([^"]+)"\s*$)re");
+  const std::string source = KernelSource(file);
+  std::istringstream lines(source);
+  std::string out;
+  std::string line;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    std::smatch m;
+    if (!std::regex_match(line, m, kInclude)) {
+      out += line + "\n";
+      continue;
+    }
+    const std::string where = std::string(file) + ":" + std::to_string(number);
+    if (depth >= kMaxIncludeDepth) {
+      throw Error(where + ": #include \"" + m[1].str() + "\" nested deeper than " +
+                  std::to_string(kMaxIncludeDepth) + " files (an include cycle?)");
+    }
+    std::string included;
+    try {
+      included = ExpandIncludes(m[1].str(), depth + 1);
+    } catch (const Error& e) {
+      if (depth + 1 >= kMaxIncludeDepth) throw;
+      throw Error(where + ": " + e.what());
+    }
+    out += "#line 1 \"" + m[1].str() + "\"\n" + included;
+    out += "#line " + std::to_string(number + 1) + " \"" + std::string(file) + "\"\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string ProgramSource(std::string_view file) { return ExpandIncludes(file, 0); }
 
 }  // namespace sapmvs

@@ -20,6 +20,15 @@ std::string KernelSource(std::string_view file);
 // The embedded copy only, ignoring SAPMVS_KERNEL_DIR. Throws like KernelSource.
 std::string EmbeddedKernelSource(std::string_view file);
 
+// The source a program is built from: KernelSource(file) with every line
+// `#include "other.cl"` replaced by ProgramSource("other.cl"), between #line
+// directives so that build logs name the right file and line. This is how
+// kernels share primitives (ncc.cl, bilinear.cl) while each file stays valid
+// OpenCL C: the embedded sources have no file system for the device
+// compiler's own #include. Throws Error naming the including file and line
+// for an unknown file, and for includes nested deeper than 8 (a cycle).
+std::string ProgramSource(std::string_view file);
+
 // Names of the embedded kernel files, sorted.
 std::vector<std::string> EmbeddedKernelFiles();
 

@@ -72,10 +72,10 @@ static_assert(sizeof(NccPair) == sizeof(cl_int2), "NccPair is uploaded as int2")
 NccCamera MakeNccCamera(const Camera& local_camera, const char* what = "camera");
 NccPatch MakeNccPatch(const Eigen::Vector3d& center, const Eigen::Vector3d& normal, int reference);
 
-// The build options of every program that carries ncc_of (ncc_score.cl and
-// its verbatim copies in patch_refine.cl and roofline_probe.cl): the NCC's
-// variance floor, the sample weights, the patch side and the work-group size,
-// so that the copies are built alike.
+// The build options of every program that includes ncc.cl (ncc_score.cl,
+// patch_refine.cl and roofline_probe.cl): the NCC's variance floor, the
+// sample weights, the patch side and the work-group size, so that the three
+// score alike.
 BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color);
 
 // ---------------------------------------------------------------------------
@@ -146,8 +146,8 @@ class NccScorer {
   std::vector<float> Score(const std::vector<NccPatch>& patches, const std::vector<NccPair>& pairs,
                            ClEvent* event = nullptr);
 
-  // values[k] = image `image` of the uploaded group at points[k], through the
-  // kernel file's copy of bilinear_at (tests compare it with the original).
+  // values[k] = image `image` of the uploaded group at points[k], through
+  // ncc.cl's sample_image (bilinear_at over the packed image table).
   std::vector<float> ProbeSamples(int image, const std::vector<Eigen::Vector2f>& points);
 
   const NccScorerOptions& options() const { return options_; }

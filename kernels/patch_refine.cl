@@ -6,11 +6,10 @@
 // double-precision twin and must keep exactly the same parameterisation, step
 // schedule and tie rules.
 //
-// The NCC primitives below (NccCamera, NccPatch, bilinear_at, sample_image,
-// sample_projection, ncc_of, ncc_weights) are copied verbatim from ncc_score.cl, because
-// the kernel embedding has no #include; tests/patch_refiner_test.cc compares
-// the text. The grid geometry of patch_views_ncc is that of the ncc_score
-// kernel body.
+// The NCC primitives (NccCamera, NccPatch, bilinear_at, sample_image,
+// sample_projection, ncc_of, ncc_weights) come from ncc.cl, as in
+// ncc_score.cl. The grid geometry of patch_views_ncc is that of the
+// ncc_score kernel body.
 //
 // Build options (the host passes all of them; see sapmvs/kernel_limits.h):
 //   WORK_GROUP_SIZE   work-items per group; the launch must use exactly this.
@@ -22,39 +21,11 @@
 #ifndef WORK_GROUP_SIZE
 #define WORK_GROUP_SIZE 64
 #endif
-#ifndef PATCH_SIZE
-#define PATCH_SIZE 7
-#endif
-#ifndef NCC_MIN_VARIANCE
-#define NCC_MIN_VARIANCE 1e-4f
-#endif
-#ifndef NCC_SIGMA_COLOR
-#define NCC_SIGMA_COLOR 0.0f
-#endif
 #ifndef MAX_VIEWS
 #define MAX_VIEWS 8
 #endif
 
-#define NCC_NUM_SAMPLES (PATCH_SIZE * PATCH_SIZE)
-
-// Same guard as in ncc_score.cl. Host twin: kNccMinAxisLength.
-#define NCC_MIN_AXIS_LENGTH 1e-3f
-
-// One image's camera (host: NccCamera, 96 bytes).
-typedef struct {
-  float4 p0, p1, p2;  // Rows of the 3x4 projection matrix K [R | t], local frame.
-  float4 x_axis;      // Camera x axis in the world (row 0 of R_wc); w = 0.
-  float4 y_axis;      // Camera y axis in the world (row 1 of R_wc); w = 0.
-  float4 center;      // xyz: projection centre (local); w: mean focal length, pixels.
-} NccCamera;
-
-// One patch (host: NccPatch, 48 bytes).
-typedef struct {
-  float4 center;  // xyz: patch centre c (local); w ignored.
-  float4 normal;  // xyz: unit normal n; w ignored.
-  int reference;  // Index of the reference image R(p).
-  int reserved0, reserved1, reserved2;
-} NccPatch;
+#include "ncc.cl"
 
 // One refined patch (host: RefinedPatchOut, 48 bytes).
 typedef struct {
@@ -63,127 +34,6 @@ typedef struct {
   float4 params;  // x: depth offset along the ray from the start, in footprints;
                   // y: yaw, z: pitch (radians); w: accepted moves.
 } RefinedPatchOut;
-
-// Copied verbatim from bilinear_sample.cl, because the kernel embedding has no
-// #include: keep the two identical (tests/ncc_scorer_test.cc compares the
-// text). Bilinear value of `image` at (x, y); NaN unless 0 <= x <= width - 1
-// and 0 <= y <= height - 1.
-float bilinear_at(__global const float* image, int width, int height, int row_pitch, float x,
-                  float y) {
-  // Written negated so that NaN coordinates, which compare false, are rejected.
-  if (!(x >= 0.0f && y >= 0.0f && x <= (float)(width - 1) && y <= (float)(height - 1))) {
-    return NAN;
-  }
-  // Clamping the cell keeps x == width - 1 from reading column `width`; the
-  // fraction then becomes 1 (or 0 for a 1-pixel-wide image, where x1 == x0).
-  const int x0 = min((int)x, max(width - 2, 0));
-  const int y0 = min((int)y, max(height - 2, 0));
-  const int x1 = min(x0 + 1, width - 1);
-  const int y1 = min(y0 + 1, height - 1);
-  const float fx = x - (float)x0;
-  const float fy = y - (float)y0;
-  __global const float* row0 = image + (size_t)y0 * (size_t)row_pitch;
-  __global const float* row1 = image + (size_t)y1 * (size_t)row_pitch;
-  // (1 - f) * a + f * b rather than a + f * (b - a): exact at f = 0 and f = 1,
-  // so pixel centres reproduce the pixel bit for bit.
-  const float top = (1.0f - fx) * row0[x0] + fx * row0[x1];
-  const float bottom = (1.0f - fx) * row1[x0] + fx * row1[x1];
-  return (1.0f - fy) * top + fy * bottom;
-}
-
-// Image `index` of the packed buffer sampled at (x, y). `table[index]` is
-// (offset in elements, width, height, row pitch).
-float sample_image(__global const float* images, __global const int4* table, int index, float x,
-                   float y) {
-  const int4 t = table[index];
-  return bilinear_at(images + t.x, t.y, t.z, t.w, x, y);
-}
-
-// `camera` sampled at the projection of the local point `X`; NaN when `X` is
-// not strictly in front of the camera or projects outside the image.
-float sample_projection(__global const float* images, __global const int4* table, int index,
-                        const NccCamera camera, float3 X) {
-  const float4 h = (float4)(X, 1.0f);
-  const float w = dot(camera.p2, h);
-  if (!(w > 0.0f)) {
-    return NAN;
-  }
-  return sample_image(images, table, index, dot(camera.p0, h) / w, dot(camera.p1, h) / w);
-}
-
-// The NCC of `a` and `b` (NCC_NUM_SAMPLES values each), each sample k
-// weighted by w[k] (ncc_weights), two-pass so that bright images do not lose
-// the variance to cancellation; NaN when either weighted variance is below
-// NCC_MIN_VARIANCE. With every weight 1 it is the plain NCC.
-float ncc_of(const float* a, const float* b, const float* w) {
-  float sum_w = 0.0f;
-  float mean_a = 0.0f;
-  float mean_b = 0.0f;
-  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-    sum_w += w[k];
-    mean_a += w[k] * a[k];
-    mean_b += w[k] * b[k];
-  }
-  mean_a /= sum_w;
-  mean_b /= sum_w;
-  float saa = 0.0f;
-  float sbb = 0.0f;
-  float sab = 0.0f;
-  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-    const float da = a[k] - mean_a;
-    const float db = b[k] - mean_b;
-    saa += w[k] * da * da;
-    sbb += w[k] * db * db;
-    sab += w[k] * da * db;
-  }
-  const float min_sum = NCC_MIN_VARIANCE * sum_w;
-  if (!(saa >= min_sum && sbb >= min_sum)) {
-    return NAN;
-  }
-  return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
-}
-
-// The weights of the reference samples `a`: 1 each when NCC_SIGMA_COLOR is
-// 0, else exp(-d^2 / 2 s^2) for d the sample's difference from the centre
-// sample and s = NCC_SIGMA_COLOR standard deviations of the 3 x 3 samples
-// around the centre (relative, so that one setting suits dim scans and bright
-// renderings alike). A window
-// that straddles a wall or a roof edge then scores the surface under its
-// centre more than the mixture. A flat window keeps weights 1 (and gets NaN
-// from ncc_of's variance floor). native_exp (core OpenCL, not an extension):
-// a weight needs a few digits only, and with exp the weighted search took
-// 60 % longer than plain NCC on Herz-Jesu under PoCL (native_exp: 25 %).
-void ncc_weights(const float* a, float* w) {
-  if (!(NCC_SIGMA_COLOR > 0.0f)) {
-    for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-      w[k] = 1.0f;
-    }
-    return;
-  }
-  // The spread of the 3 x 3 samples around the centre: the texture of the
-  // centre's surface, not inflated by another surface further out.
-  const int c = NCC_NUM_SAMPLES / 2;
-  float mean = 0.0f;
-  for (int r = -1; r <= 1; ++r) {
-    for (int q = -1; q <= 1; ++q) {
-      mean += a[c + r * PATCH_SIZE + q];
-    }
-  }
-  mean /= 9.0f;
-  float var = 0.0f;
-  for (int r = -1; r <= 1; ++r) {
-    for (int q = -1; q <= 1; ++q) {
-      const float d = a[c + r * PATCH_SIZE + q] - mean;
-      var += d * d;
-    }
-  }
-  const float s = NCC_SIGMA_COLOR * sqrt(var / 9.0f);
-  const float centre = a[c];
-  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-    const float d = a[k] - centre;
-    w[k] = s > 0.0f ? native_exp(-0.5f * (d * d) / (s * s)) : 1.0f;
-  }
-}
 
 // The patch frame: e_z points from the initial centre towards the reference
 // camera, e_x is the reference x axis made orthogonal to e_z, e_y = e_z x e_x.

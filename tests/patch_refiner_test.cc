@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "cl_test_fixture.h"
-#include "kernel_source.h"
 #include "plane_scene.h"
 #include "sapmvs/error.h"
 #include "sapmvs/kernel_limits.h"
@@ -114,25 +113,6 @@ TEST(PatchRefinerOptionsTest, CheckRejectsBadValues) {
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.depth_step = std::nan(""); }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.angle_step_deg = 60.0; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.max_angle_deg = 90.0; }));
-}
-
-TEST(PatchRefineKernelTextTest, NccHelpersAreVerbatimCopies) {
-  const std::string ncc = EmbeddedKernelSource("ncc_score.cl");
-  const std::string refine = EmbeddedKernelSource("patch_refine.cl");
-  const std::string begin = "// Copied verbatim from bilinear_sample.cl";
-  const size_t a0 = ncc.find(begin);
-  const size_t a1 = ncc.find("// scores[i] = NCC of patch");
-  const size_t b0 = refine.find(begin);
-  const size_t b1 = refine.find("// The patch frame:");
-  ASSERT_NE(a0, std::string::npos);
-  ASSERT_NE(a1, std::string::npos);
-  ASSERT_NE(b0, std::string::npos);
-  ASSERT_NE(b1, std::string::npos);
-  EXPECT_EQ(ncc.substr(a0, a1 - a0), refine.substr(b0, b1 - b0));
-  // The struct typedefs too.
-  const std::string camera =
-      ncc.substr(ncc.find("typedef struct"), ncc.find("} NccPatch;") - ncc.find("typedef struct"));
-  EXPECT_NE(refine.find(camera), std::string::npos);
 }
 
 // Distance of a refined centre to the plane z = 0 along the reference ray, in

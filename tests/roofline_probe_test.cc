@@ -5,7 +5,6 @@
 #include <random>
 
 #include "cl_test_fixture.h"
-#include "kernel_source.h"
 #include "sapmvs/error.h"
 #include "test_util.h"
 
@@ -80,21 +79,6 @@ TEST_F(RooflineProbeTest, CopyCopiesOddCountsExactly) {
     for (int k = 0; k < 4; ++k) ASSERT_EQ(out[i].s[k], src[i].s[k]) << i;
   for (int i = n; i < n + 3; ++i) EXPECT_EQ(out[i].s[0], -7.0f);  // nothing past n
   EXPECT_THROW(probe.Copy(s, d, n + 1), Error);
-}
-
-TEST(RooflineProbeKernelText, NccIsAVerbatimCopyOfTheScoringKernels) {
-  const std::string ncc = EmbeddedKernelSource("ncc_score.cl");
-  const std::string probe = EmbeddedKernelSource("roofline_probe.cl");
-  const std::string begin = "// The NCC of `a` and `b`";
-  const size_t a0 = ncc.find(begin), b0 = probe.find(begin);
-  ASSERT_NE(a0, std::string::npos);
-  ASSERT_NE(b0, std::string::npos);
-  // Through the end of ncc_weights, which follows ncc_of.
-  const size_t a1 = ncc.find("\n}\n", ncc.find("void ncc_weights(", a0));
-  const size_t b1 = probe.find("\n}\n", probe.find("void ncc_weights(", b0));
-  ASSERT_NE(a1, std::string::npos);
-  ASSERT_NE(b1, std::string::npos);
-  EXPECT_EQ(ncc.substr(a0, a1 - a0), probe.substr(b0, b1 - b0));
 }
 
 TEST(RooflineProbeOptions, BadOptionsNameTheValue) {

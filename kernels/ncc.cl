@@ -1,0 +1,146 @@
+// The NCC primitives shared by ncc_score.cl, patch_refine.cl and
+// roofline_probe.cl, so that the three score exactly the same arithmetic:
+// the camera and patch structs, projection and sampling, the weighted NCC
+// and its sample weights. NccScoreReference (host/ncc_scorer.cc) is the
+// double-precision twin. Programs get it by `#include "ncc.cl"`, which the
+// host expands when it builds them (host/kernel_source.h, ProgramSource).
+//
+// Build options it reads (the host passes all of them; see
+// sapmvs/kernel_limits.h):
+//   PATCH_SIZE        μ, samples per side of the patch grid (odd).
+//   NCC_MIN_VARIANCE  smallest per-sample variance of a sample vector.
+//   NCC_SIGMA_COLOR   > 0 weights the NCC samples (ncc_weights); 0 = plain NCC.
+
+#ifndef SAPMVS_NCC_CL
+#define SAPMVS_NCC_CL
+
+#ifndef PATCH_SIZE
+#define PATCH_SIZE 7
+#endif
+#ifndef NCC_MIN_VARIANCE
+#define NCC_MIN_VARIANCE 1e-4f
+#endif
+#ifndef NCC_SIGMA_COLOR
+#define NCC_SIGMA_COLOR 0.0f
+#endif
+
+#define NCC_NUM_SAMPLES (PATCH_SIZE * PATCH_SIZE)
+
+// Shortest length the reference camera's x axis may keep once projected onto
+// the patch plane; shorter means the plane (nearly) contains that axis and
+// the in-plane grid axes are undefined. Host twin: kNccMinAxisLength.
+#define NCC_MIN_AXIS_LENGTH 1e-3f
+
+// One image's camera (host: NccCamera, 96 bytes).
+typedef struct {
+  float4 p0, p1, p2;  // Rows of the 3x4 projection matrix K [R | t], local frame.
+  float4 x_axis;      // Camera x axis in the world (row 0 of R_wc); w = 0.
+  float4 y_axis;      // Camera y axis in the world (row 1 of R_wc); w = 0.
+  float4 center;      // xyz: projection centre (local); w: mean focal length, pixels.
+} NccCamera;
+
+// One patch (host: NccPatch, 48 bytes).
+typedef struct {
+  float4 center;  // xyz: patch centre c (local); w ignored.
+  float4 normal;  // xyz: unit normal n; w ignored.
+  int reference;  // Index of the reference image R(p).
+  int reserved0, reserved1, reserved2;
+} NccPatch;
+
+#include "bilinear.cl"
+
+// Image `index` of the packed buffer sampled at (x, y). `table[index]` is
+// (offset in elements, width, height, row pitch).
+float sample_image(__global const float* images, __global const int4* table, int index, float x,
+                   float y) {
+  const int4 t = table[index];
+  return bilinear_at(images + t.x, t.y, t.z, t.w, x, y);
+}
+
+// `camera` sampled at the projection of the local point `X`; NaN when `X` is
+// not strictly in front of the camera or projects outside the image.
+float sample_projection(__global const float* images, __global const int4* table, int index,
+                        const NccCamera camera, float3 X) {
+  const float4 h = (float4)(X, 1.0f);
+  const float w = dot(camera.p2, h);
+  if (!(w > 0.0f)) {
+    return NAN;
+  }
+  return sample_image(images, table, index, dot(camera.p0, h) / w, dot(camera.p1, h) / w);
+}
+
+// The NCC of `a` and `b` (NCC_NUM_SAMPLES values each), each sample k
+// weighted by w[k] (ncc_weights), two-pass so that bright images do not lose
+// the variance to cancellation; NaN when either weighted variance is below
+// NCC_MIN_VARIANCE. With every weight 1 it is the plain NCC.
+float ncc_of(const float* a, const float* b, const float* w) {
+  float sum_w = 0.0f;
+  float mean_a = 0.0f;
+  float mean_b = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    sum_w += w[k];
+    mean_a += w[k] * a[k];
+    mean_b += w[k] * b[k];
+  }
+  mean_a /= sum_w;
+  mean_b /= sum_w;
+  float saa = 0.0f;
+  float sbb = 0.0f;
+  float sab = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    const float da = a[k] - mean_a;
+    const float db = b[k] - mean_b;
+    saa += w[k] * da * da;
+    sbb += w[k] * db * db;
+    sab += w[k] * da * db;
+  }
+  const float min_sum = NCC_MIN_VARIANCE * sum_w;
+  if (!(saa >= min_sum && sbb >= min_sum)) {
+    return NAN;
+  }
+  return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+}
+
+// The weights of the reference samples `a`: 1 each when NCC_SIGMA_COLOR is
+// 0, else exp(-d^2 / 2 s^2) for d the sample's difference from the centre
+// sample and s = NCC_SIGMA_COLOR standard deviations of the 3 x 3 samples
+// around the centre (relative, so that one setting suits dim scans and bright
+// renderings alike). A window
+// that straddles a wall or a roof edge then scores the surface under its
+// centre more than the mixture. A flat window keeps weights 1 (and gets NaN
+// from ncc_of's variance floor). native_exp (core OpenCL, not an extension):
+// a weight needs a few digits only, and with exp the weighted search took
+// 60 % longer than plain NCC on Herz-Jesu under PoCL (native_exp: 25 %).
+void ncc_weights(const float* a, float* w) {
+  if (!(NCC_SIGMA_COLOR > 0.0f)) {
+    for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+      w[k] = 1.0f;
+    }
+    return;
+  }
+  // The spread of the 3 x 3 samples around the centre: the texture of the
+  // centre's surface, not inflated by another surface further out.
+  const int c = NCC_NUM_SAMPLES / 2;
+  float mean = 0.0f;
+  for (int r = -1; r <= 1; ++r) {
+    for (int q = -1; q <= 1; ++q) {
+      mean += a[c + r * PATCH_SIZE + q];
+    }
+  }
+  mean /= 9.0f;
+  float var = 0.0f;
+  for (int r = -1; r <= 1; ++r) {
+    for (int q = -1; q <= 1; ++q) {
+      const float d = a[c + r * PATCH_SIZE + q] - mean;
+      var += d * d;
+    }
+  }
+  const float s = NCC_SIGMA_COLOR * sqrt(var / 9.0f);
+  const float centre = a[c];
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    const float d = a[k] - centre;
+    w[k] = s > 0.0f ? native_exp(-0.5f * (d * d) / (s * s)) : 1.0f;
+  }
+}
+
+#endif  // SAPMVS_NCC_CL
