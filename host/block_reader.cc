@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <iostream>
+#include <sstream>
 
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
@@ -62,12 +64,22 @@ std::string ToString(BlockFormat format) {
   return "?";
 }
 
-bool BlockReadOptions::Check() const {
+std::string BlockReadOptions::Problem() const {
   if (!image_dir.empty() && !fs::is_directory(image_dir)) {
-    std::cerr << "BlockReadOptions: image_dir " << image_dir << " is not a folder\n";
-    return false;
+    return "image_dir " + image_dir.string() + " to be a folder";
   }
-  return true;
+  if (ground_height && !std::isfinite(*ground_height)) {
+    std::ostringstream s;
+    s << "a finite ground height (ground_height = " << *ground_height << ")";
+    return s.str();
+  }
+  return "";
+}
+
+bool BlockReadOptions::Check() const {
+  const std::string p = Problem();
+  if (!p.empty()) std::cerr << "BlockReadOptions: expected " << p << "\n";
+  return p.empty();
 }
 
 BlockFormat DetectBlockFormat(const fs::path& path) {
@@ -104,7 +116,9 @@ BlockFormat DetectBlockFormat(const fs::path& path) {
 }
 
 Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
-  if (!options.Check()) throw Error("invalid block read options");
+  if (const std::string p = options.Problem(); !p.empty()) {
+    throw Error("block read options: expected " + p);
+  }
   const BlockFormat format =
       options.format == BlockFormat::kAuto ? DetectBlockFormat(path) : options.format;
   Block block;
@@ -128,6 +142,7 @@ Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
       break;
   }
   block.source = path;
+  if (options.ground_height) block.ground_height = options.ground_height;
   block.format = ToString(format);
   if (block.images.empty()) throw Error(path.string() + ": block has no images");
   for (const BlockImage& im : block.images) {

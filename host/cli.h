@@ -29,8 +29,10 @@ struct BlockFlags {
   double ground_height = std::numeric_limits<double>::quiet_NaN();
 };
 void AddBlockFlags(CLI::App* cmd, BlockFlags* flags);
+// The flags as BlockReadOptions; throws Error for an unknown format.
+BlockReadOptions ReadOptionsOf(const BlockFlags& flags);
 // Reads `path` as the flags say; throws Error for a bad flag value.
-Block ReadBlockWithFlags(const std::string& path, BlockFlags& flags);
+Block ReadBlockWithFlags(const std::string& path, const BlockFlags& flags);
 
 void RegisterDevicesCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterInfoCommand(CLI::App& app, const GlobalFlags& global);

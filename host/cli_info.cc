@@ -129,14 +129,15 @@ void AddBlockFlags(CLI::App* cmd, BlockFlags* flags) {
                   "Mean ground height (block units) for blocks that carry no surface estimate");
 }
 
-Block ReadBlockWithFlags(const std::string& path, BlockFlags& flags) {
-  flags.read.format = ParseBlockFormat(flags.format);
-  Block block = ReadBlock(path, flags.read);
-  if (!std::isnan(flags.ground_height)) {
-    if (!std::isfinite(flags.ground_height)) throw Error("--ground-height must be finite");
-    block.ground_height = flags.ground_height;
-  }
-  return block;
+BlockReadOptions ReadOptionsOf(const BlockFlags& flags) {
+  BlockReadOptions read = flags.read;
+  read.format = ParseBlockFormat(flags.format);
+  if (!std::isnan(flags.ground_height)) read.ground_height = flags.ground_height;
+  return read;
+}
+
+Block ReadBlockWithFlags(const std::string& path, const BlockFlags& flags) {
+  return ReadBlock(path, ReadOptionsOf(flags));
 }
 
 }  // namespace sapmvs::cli

@@ -66,11 +66,11 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
     }
     if (const std::string problem = args->grouping.Problem(); !problem.empty())
       throw Error("plan: expected " + problem);
-    args->flags.read.format = ParseBlockFormat(args->flags.format);
+    const BlockReadOptions read = ReadOptionsOf(args->flags);
     // A JSON path in a missing folder fails here, before the block is read.
     std::unique_ptr<AtomicFile> json;
     if (!args->json.empty()) json = std::make_unique<AtomicFile>(args->json);
-    const Block block = ReadBlockWithFlags(args->block, args->flags);
+    const Block block = ReadBlock(args->block, read);
     const GroupingPlan plan = PlanGroups(block, args->grouping);
     PrintPlan(block, plan, std::cout);
     if (json) {

@@ -113,9 +113,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
           ->expected(0, 1);
   cmd->callback(
       [o, block_flags, mode, no_edges, strategy, budget, profile, profile_option, &global] {
-        o->read = block_flags->read;
-        o->read.format = ParseBlockFormat(block_flags->format);
-        o->ground_height = block_flags->ground_height;
+        o->read = ReadOptionsOf(*block_flags);
         o->profile = profile_option->count() > 0;
         o->grouping.strategy = ParseGroupingStrategy(*strategy);
         o->grouping.memory_budget = ParseByteSize(*budget);

@@ -28,9 +28,6 @@ namespace sapmvs {
 std::string RunOptions::Problem() const {
   if (block.empty()) return "a block path";
   if (out.empty()) return "an output folder (--out)";
-  if (!std::isnan(ground_height) && !std::isfinite(ground_height)) {
-    return "a finite ground height (ground_height = " + std::to_string(ground_height) + ")";
-  }
   std::string p = matcher.Problem();
   if (!p.empty()) return p;
   GroupingOptions g = grouping;
@@ -146,8 +143,7 @@ RunReport RunDense(const RunOptions& options) {
     stage_start = std::chrono::steady_clock::now();
   };
 
-  Block block = ReadBlock(options.block, options.read);
-  if (!std::isnan(options.ground_height)) block.ground_height = options.ground_height;
+  const Block block = ReadBlock(options.block, options.read);
   report.images = static_cast<int>(block.images.size());
   const BlockGeometry geometry = EstimateBlockGeometry(block);
   GroupingOptions gopt = options.grouping;

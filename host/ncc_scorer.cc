@@ -335,16 +335,16 @@ std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<N
     if (sigma > 0.0) {
       // Same weights as ncc_weights: the spread of the 3 x 3 samples around
       // the centre, times sigma.
-      const size_t c = num_samples / 2;
+      const size_t mid = num_samples / 2;
       double mean = 0.0, var = 0.0;
       for (int r = -1; r <= 1; ++r)
-        for (int q = -1; q <= 1; ++q) mean += a[c + r * patch_size + q];
+        for (int q = -1; q <= 1; ++q) mean += a[mid + r * patch_size + q];
       mean /= 9.0;
       for (int r = -1; r <= 1; ++r)
-        for (int q = -1; q <= 1; ++q) var += std::pow(a[c + r * patch_size + q] - mean, 2);
+        for (int q = -1; q <= 1; ++q) var += std::pow(a[mid + r * patch_size + q] - mean, 2);
       const double s = sigma * std::sqrt(var / 9.0);
       for (size_t k = 0; k < num_samples; ++k) {
-        const double d = a[k] - a[c];
+        const double d = a[k] - a[mid];
         weight[k] = s > 0.0 ? std::exp(-0.5 * (d * d) / (s * s)) : 1.0;
       }
     }

@@ -8,6 +8,7 @@
 //   opensfm  OpenSfM reconstruction.json (perspective, brown)
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -28,7 +29,12 @@ struct BlockReadOptions {
   std::filesystem::path image_dir;
   // Compare every image's header size with its camera (cheap: no decoding).
   bool check_image_sizes = true;
+  // Mean ground height, block units, replacing the block's own; for blocks
+  // that carry no surface estimate. Finite.
+  std::optional<double> ground_height;
 
+  // Empty when usable, else what was expected, naming the value.
+  std::string Problem() const;
   bool Check() const;
 };
 

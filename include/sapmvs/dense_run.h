@@ -13,7 +13,6 @@
 // was never interrupted.
 #include <filesystem>
 #include <iosfwd>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -27,11 +26,8 @@ namespace sapmvs {
 
 struct RunOptions {
   std::filesystem::path block;  // any format ReadBlock takes
-  // How to read it (format, image folder, image size check).
+  // How to read it (format, image folder, size check, ground height).
   BlockReadOptions read;
-  // Mean ground height, block units, for blocks that carry no surface
-  // estimate (NaN = the block's own).
-  double ground_height = std::numeric_limits<double>::quiet_NaN();
   std::filesystem::path out;  // output folder, created when missing
   // OpenCL device: index or name substring ("" = SAPMVS_DEVICE, else the default).
   std::string device;
