@@ -11,12 +11,9 @@ namespace sapmvs {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// Optical axes closer to parallel than this do not triangulate a usable point.
-constexpr double kMinAxisAngleRad = 3.0 * 3.14159265358979 / 180.0;
-// Largest gap between two optical axes, relative to the range, for their
-// closest approach to count as a scene point.
-constexpr double kMaxAxisGap = 0.05;
-
+// Fewer tie points than this over a whole block are chance matches, not a
+// surface.
+constexpr size_t kMinTiePoints = 20;
 double Median(std::vector<double> v) {
   if (v.empty()) return kNaN;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -34,33 +31,6 @@ Eigen::Vector3d OnPlaneZ(const Camera& cam, const Eigen::Vector2d& uv, double z)
   const double t = (z - cam.center().z()) / d.z();
   if (!(t > 0) || !std::isfinite(t)) return Eigen::Vector3d::Constant(kNaN);
   return cam.center() + t * d;
-}
-
-// Midpoints of the shortest segments between convergent optical axes.
-std::vector<Eigen::Vector3d> AxisIntersections(const Block& block) {
-  std::vector<Eigen::Vector3d> out;
-  const size_t n = block.images.size();
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = i + 1; j < n; ++j) {
-      const Camera& a = block.images[i].camera;
-      const Camera& b = block.images[j].camera;
-      const Eigen::Vector3d da = a.ViewingDirection(), db = b.ViewingDirection();
-      const double c = da.dot(db);
-      if (std::acos(std::clamp(c, -1.0, 1.0)) < kMinAxisAngleRad) continue;
-      const Eigen::Vector3d w = a.center() - b.center();
-      const double den = 1 - c * c;
-      const double sa = (c * db.dot(w) - da.dot(w)) / den;
-      const double sb = (db.dot(w) - c * da.dot(w)) / den;
-      if (sa <= 0 || sb <= 0) continue;
-      // Axes that pass each other far apart (oblique views in opposite
-      // directions) meet nowhere near the scene.
-      const Eigen::Vector3d pa = a.center() + sa * da, pb = b.center() + sb * db;
-      if ((pa - pb).norm() > kMaxAxisGap * std::min(sa, sb)) continue;
-      const Eigen::Vector3d p = 0.5 * (pa + pb);
-      if (a.InImage(a.Project(p)) && b.InImage(b.Project(p))) out.push_back(p);
-    }
-  }
-  return out;
 }
 
 // Median depth of the points that project into the image.
@@ -84,8 +54,8 @@ std::string ToString(SurfaceSource source) {
       return "sparse points";
     case SurfaceSource::kGroundHeight:
       return "ground height";
-    case SurfaceSource::kConvergentAxes:
-      return "convergent optical axes";
+    case SurfaceSource::kTiePoints:
+      return "tie points";
     case SurfaceSource::kNone:
       return "none";
   }
@@ -97,9 +67,10 @@ BlockGeometry EstimateBlockGeometry(const Block& block) {
   g.images.resize(block.images.size());
   std::optional<Dem> dem;
   if (!block.dem.empty()) dem = Dem::Load(block.dem);
-  std::vector<Eigen::Vector3d> axis_points;
+  std::vector<Eigen::Vector3d> tie_positions;
   if (!dem && block.sparse_points.empty() && !block.ground_height) {
-    axis_points = AxisIntersections(block);
+    g.tie_points = TriangulateTiePoints(block);
+    for (const TiePoint& t : g.tie_points) tie_positions.push_back(t.position);
   }
   if (dem)
     g.source = SurfaceSource::kDem;
@@ -107,8 +78,8 @@ BlockGeometry EstimateBlockGeometry(const Block& block) {
     g.source = SurfaceSource::kSparsePoints;
   else if (block.ground_height)
     g.source = SurfaceSource::kGroundHeight;
-  else if (!axis_points.empty())
-    g.source = SurfaceSource::kConvergentAxes;
+  else if (tie_positions.size() >= kMinTiePoints)
+    g.source = SurfaceSource::kTiePoints;
 
   int down = 0;
   std::vector<double> gsds, heights;
@@ -125,9 +96,9 @@ BlockGeometry EstimateBlockGeometry(const Block& block) {
         if (!p.allFinite()) p = OnPlaneZ(cam, center, dem->MedianHeight());
         break;
       case SurfaceSource::kSparsePoints:
-      case SurfaceSource::kConvergentAxes:
+      case SurfaceSource::kTiePoints:
         if (auto d = MedianDepth(cam, g.source == SurfaceSource::kSparsePoints ? block.sparse_points
-                                                                               : axis_points)) {
+                                                                               : tie_positions)) {
           p = cam.BackProject(center, *d);
         }
         break;

@@ -54,6 +54,10 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
   cmd->add_option("--tile-views", g.tile_views,
                   "footprint: images a tile's points should be seen in")
       ->capture_default_str();
+  cmd->add_option("--min-image-num", g.min_image_num,
+                  "Images a patch must be seen in (run's --min-image-num): groups are checked "
+                  "for images with fewer overlapping views")
+      ->capture_default_str();
   cmd->add_option("--json", args->json, "Also write the plan as JSON to this file");
   AddBlockFlags(cmd, &args->flags);
   cmd->callback([args] {

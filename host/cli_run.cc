@@ -40,7 +40,9 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--min-image-num", m.min_image_num, "Images a patch must be photo-consistent in")
       ->capture_default_str();
-  cmd->add_option("--max-angle", m.max_angle_deg, "Smallest triangulation angle of a view, degrees")
+  cmd->add_option(
+         "--max-angle", m.max_angle_deg,
+         "PMVS2's maxAngle: some pair of a patch's images must meet at more than this, degrees")
       ->capture_default_str();
   cmd->add_option("--view-angle", m.view_angle_deg,
                   "Largest angle of a view to a patch normal, degrees")

@@ -32,6 +32,7 @@ std::string RunOptions::Problem() const {
   if (!p.empty()) return p;
   GroupingOptions g = grouping;
   g.level = matcher.level;
+  g.min_image_num = matcher.min_image_num;
   p = g.Problem();
   if (!p.empty()) return p;
   if (max_groups < 0) return "max_groups >= 0 (max_groups = " + std::to_string(max_groups) + ")";
@@ -148,6 +149,7 @@ RunReport RunDense(const RunOptions& options) {
   const BlockGeometry geometry = EstimateBlockGeometry(block);
   GroupingOptions gopt = options.grouping;
   gopt.level = options.matcher.level;
+  gopt.min_image_num = options.matcher.min_image_num;
   GroupingPlan plan;
   ImageGroup all;
   all.images.resize(block.images.size());

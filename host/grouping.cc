@@ -129,6 +129,36 @@ std::vector<std::vector<int>> CutRuns(const std::vector<int>& strip, size_t k) {
   return runs;
 }
 
+// Share of image i's footprint that image j sees (7 x 7 samples, as
+// SelectViews counts views); 1 when either has no footprint, since nothing
+// then says they do not overlap.
+double OverlapShare(const std::vector<Footprint>& fp, int i, int j) {
+  if (!fp[i].valid || !fp[j].valid) return 1.0;
+  constexpr int kGrid = 7;
+  int inside = 0;
+  for (int gy = 0; gy < kGrid; ++gy) {
+    for (int gx = 0; gx < kGrid; ++gx) {
+      const double u = (gx + 0.5) / kGrid, v = (gy + 0.5) / kGrid;
+      const auto& c = fp[i].corners;
+      const Eigen::Vector2d p =
+          (1 - v) * ((1 - u) * c[0] + u * c[1]) + v * ((1 - u) * c[3] + u * c[2]);
+      inside += fp[j].Contains(p);
+    }
+  }
+  return static_cast<double>(inside) / (kGrid * kGrid);
+}
+
+std::vector<int> ShortOfViews(const std::vector<Footprint>& fp, const std::vector<int>& ids,
+                              int min_image_num) {
+  std::vector<int> out;
+  for (const int i : ids) {
+    int views = 0;
+    for (const int j : ids) views += j != i && OverlapShare(fp, i, j) >= 0.1;
+    if (views < min_image_num - 1) out.push_back(i);
+  }
+  return out;
+}
+
 void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<Footprint>& fp,
                 GroupingPlan* plan) {
   std::vector<int> singles;
@@ -146,6 +176,21 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
       if (std::all_of(runs.begin(), runs.end(),
                       [&](const std::vector<int>& r) { return Fits(block, r, o); }))
         break;
+    }
+    // A run of fewer images than a patch needs matches nothing (a strip of
+    // 14 cut 6+6+2): it takes the strip images before it, which the run
+    // before it matched too; the merge keeps one of the duplicates.
+    for (size_t r = 1; r < runs.size(); ++r) {
+      std::vector<int>& run = runs[r];
+      auto first = std::find(strip.begin(), strip.end(), run.front());
+      while (static_cast<int>(run.size()) < std::min(o.min_image_num, o.max_images) &&
+             first != strip.begin()) {
+        std::vector<int> with = run;
+        with.insert(with.begin(), *(first - 1));
+        if (!Fits(block, with, o)) break;
+        run = std::move(with);
+        --first;
+      }
     }
     for (std::vector<int>& run : runs) {
       ImageGroup g;
@@ -349,6 +394,8 @@ std::string GroupingOptions::Problem() const {
     s << "tile_size in (0, 4] (tile_size = " << tile_size << ")";
   else if (tile_views < 2)
     s << "tile_views >= 2 (tile_views = " << tile_views << ")";
+  else if (min_image_num < 2 || min_image_num > kMaxViews)
+    s << "min_image_num in 2.." << kMaxViews << " (min_image_num = " << min_image_num << ")";
   return s.str();
 }
 
@@ -413,7 +460,10 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     PlanStrips(block, options, fp, &plan);
   else
     PlanFootprint(block, options, geometry, fp, &plan);
-  for (ImageGroup& g : plan.groups) g.memory = EstimateGroupMemory(block, g.images, options.level);
+  for (ImageGroup& g : plan.groups) {
+    g.memory = EstimateGroupMemory(block, g.images, options.level);
+    g.short_of_views = ShortOfViews(fp, g.images, options.min_image_num);
+  }
   return plan;
 }
 
@@ -459,6 +509,13 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
     }
     out << line << "\n";
   }
+  for (size_t g = 0; g < plan.groups.size(); ++g) {
+    if (plan.groups[g].short_of_views.empty()) continue;
+    out << "note        group " << g + 1 << ": image(s)";
+    for (const int i : plan.groups[g].short_of_views) out << " " << block.images[i].name;
+    out << " overlap fewer than " << o.min_image_num - 1
+        << " other images of the group and cannot be matched there\n";
+  }
   if (!plan.ungrouped.empty()) {
     out << "ungrouped  ";
     for (const int i : plan.ungrouped) out << " " << (i + 1) << " " << block.images[i].name;
@@ -483,11 +540,9 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
   j["images"] = block.images.size();
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["strategy"] = ToString(plan.strategy);
-  j["options"] = {{"max_images", o.max_images},
-                  {"memory_budget", o.memory_budget},
-                  {"level", o.level},
-                  {"tile_size", o.tile_size},
-                  {"tile_views", o.tile_views}};
+  j["options"] = {{"max_images", o.max_images}, {"memory_budget", o.memory_budget},
+                  {"level", o.level},           {"tile_size", o.tile_size},
+                  {"tile_views", o.tile_views}, {"min_image_num", o.min_image_num}};
   j["strips"] = json::array();
   for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
   j["groups"] = json::array();
@@ -497,7 +552,8 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
         {"names", names(g.images)},
         {"strip", g.strip < 0 ? json(nullptr) : json(g.strip)},
         {"center", {g.center.x(), g.center.y()}},
-        {"memory", {{"device_bytes", g.memory.device_bytes}, {"host_bytes", g.memory.host_bytes}}}};
+        {"memory", {{"device_bytes", g.memory.device_bytes}, {"host_bytes", g.memory.host_bytes}}},
+        {"short_of_views", names(g.short_of_views)}};
     if (plan.strategy == GroupingStrategy::kFootprint)
       jg["tile"] = {{"min", {g.tile_min.x(), g.tile_min.y()}},
                     {"max", {g.tile_max.x(), g.tile_max.y()}}};

@@ -84,7 +84,9 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
   return group;
 }
 
-void SelectViews(const MatcherOptions& options, MatchGroupData* group) {
+void SelectViews(const MatcherOptions& /*options*/, MatchGroupData* group) {
+  // Below this, a view is a copy of the reference's viewpoint.
+  constexpr double kMinViewAngleDeg = 0.1;
   auto& images = group->images;
   // Without any surface estimate, fall back on a depth that gives the
   // neighbours a plausible baseline: the median distance to the nearest centre
@@ -108,7 +110,9 @@ void SelectViews(const MatcherOptions& options, MatchGroupData* group) {
     for (size_t j = 0; j < images.size(); ++j) {
       if (j == i) continue;
       const Camera& other = images[j].camera;
-      if (TriangulationAngleDeg(cam.center(), other.center(), axis_point) < options.max_angle_deg) {
+      // A view from (almost) the same place adds no depth; narrow views do,
+      // together with the others (PatchEngine::WideEnough), so they stay.
+      if (TriangulationAngleDeg(cam.center(), other.center(), axis_point) < kMinViewAngleDeg) {
         continue;
       }
       int inside = 0;

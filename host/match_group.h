@@ -43,8 +43,9 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
                               const BlockGeometry* geometry = nullptr);
 
 // Picks each image's views: images whose footprint overlaps its own at the
-// expected depth and whose line of sight meets its own at >= max_angle_deg,
-// most overlap first, at most kMaxViews - 1.
+// expected depth, most overlap first, at most kMaxViews - 1. As in PMVS2,
+// views narrower than max_angle_deg take part: the angle condition applies
+// to the views a patch is matched in (PatchEngine), not to each view.
 void SelectViews(const MatcherOptions& options, MatchGroupData* group);
 
 // Angle, degrees, between the rays from camera centres a and b to x.

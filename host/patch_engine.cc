@@ -233,6 +233,28 @@ std::vector<int> PatchEngine::WorthPolishing(
   return worth;
 }
 
+bool PatchEngine::WideEnough(const Eigen::Vector3d& x, int ref,
+                             const std::vector<int>& views) const {
+  // PMVS2's checkAngles: some pair of the patch's images, the reference
+  // included, must meet at x at more than max_angle_deg (else the depth is
+  // barely constrained) and less than view_angle_deg (else the two cannot
+  // both see one plane well). Narrower views still take part in the scores:
+  // in a strip at the paper's 88 % overlap every neighbour is narrower than
+  // 10 degrees, but the neighbours on either side of the reference are not
+  // narrow to each other.
+  const double lo = std::cos(options_.max_angle_deg * M_PI / 180.0);
+  const double hi = std::cos(options_.view_angle_deg * M_PI / 180.0);
+  std::vector<Eigen::Vector3d> rays = {(group_.images[ref].camera.center() - x).normalized()};
+  for (const int v : views) rays.push_back((group_.images[v].camera.center() - x).normalized());
+  for (size_t a = 0; a < rays.size(); ++a) {
+    for (size_t b = a + 1; b < rays.size(); ++b) {
+      const double c = rays[a].dot(rays[b]);
+      if (c < lo && c > hi) return true;
+    }
+  }
+  return false;
+}
+
 std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
     const std::vector<PatchCandidate>& candidates) {
   const int need = options_.min_image_num - 1;
@@ -275,6 +297,7 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
       if (std::isfinite(s) && s >= options_.threshold_before) kept.push_back(v);
     }
     if (static_cast<int>(kept.size()) < need) continue;
+    if (!WideEnough(candidates[patch_of[k]].center, candidates[patch_of[k]].ref, kept)) continue;
     to_refine.push_back(patches[k]);
     refine_views.push_back(std::move(kept));
     refine_of.push_back(patch_of[k]);
@@ -302,7 +325,7 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
         sum += r.view_scores[v];
       }
     }
-    if (static_cast<int>(a.views.size()) < need) continue;
+    if (static_cast<int>(a.views.size()) < need || !WideEnough(a.center, a.ref, a.views)) continue;
     a.score = static_cast<float>(sum / a.views.size());
     a.size = options_.window_size;
     results[refine_of[k]] = std::move(a);
@@ -347,7 +370,8 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
           sum += x;
         }
       }
-      if (std::isfinite(r.score) && static_cast<int>(pass.size()) >= need) {
+      if (std::isfinite(r.score) && static_cast<int>(pass.size()) >= need &&
+          WideEnough(c, a.ref, pass)) {
         const double mean = sum / static_cast<double>(pass.size());
         passing.push_back(Pass{k, c, n, std::move(pass), mean});
       } else {

@@ -89,6 +89,9 @@ class PatchEngine {
   // The NCC sample weights (MatcherOptions::ncc_sigma_color; 0 in pmvs mode).
   double SigmaColor() const;
   bool OnParentPlane(const PatchCandidate& candidate, const Eigen::Vector3d& center) const;
+  // True when some pair of the reference and `views` meets at x at an angle
+  // in (max_angle_deg, view_angle_deg).
+  bool WideEnough(const Eigen::Vector3d& x, int ref, const std::vector<int>& views) const;
   std::vector<int> VisibleViews(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
                                 int ref, int half) const;
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,

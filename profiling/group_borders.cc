@@ -6,7 +6,11 @@
 // counts cross-group duplicates: points of different groups within
 // --duplicate GSDs of each other (the merge should leave none).
 //
-//   group_borders RUN_DIR --block BLOCK --truth truth/dsm.tif [--band 20]
+// With --per-group, also each group's own cloud (its checkpoint, before the
+// merge) against the surface its own images see: does a short group (the
+// paper's 4-image groups) cover its ground as well as a 6-image one?
+//
+//   group_borders RUN_DIR --block BLOCK --truth truth/dsm.tif [--band 20] [--per-group]
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -75,6 +79,9 @@ int main(int argc, char** argv) {
                  "Take the group centres from this run instead (e.g. to measure a one-group "
                  "run over the zones of a grouped one)");
   app.add_option("--level", level, "Pyramid level matched (coverage cells)")->capture_default_str();
+  bool per_group = false;
+  app.add_flag("--per-group", per_group,
+               "Also each group's checkpoint cloud against the cells its own images see");
   CLI11_PARSE(app, argc, argv);
   try {
     const std::filesystem::path dir(run_dir);
@@ -116,6 +123,31 @@ int main(int argc, char** argv) {
                 << s.median_abs_dz << std::setprecision(1) << std::setw(9) << 100 * s.coverage
                 << "%  (" << s.cells_seen << ")\n";
       std::cout.unsetf(std::ios::floatfield);
+    }
+    if (per_group) {
+      so.region = nullptr;
+      std::cout << "group  images    points   <=1 GSD  median|dz|  coverage  (cells seen by "
+                << so.min_images << "+ of its images)\n";
+      for (const auto& g : report.at("groups")) {
+        const int index = g.at("group").get<int>();
+        Block sub = block;
+        sub.images.clear();
+        for (const auto& name : g.at("images")) {
+          const int i = block.FindImage(name.get<std::string>());
+          if (i < 0) throw Error("report.json names image " + name.dump() + " not in the block");
+          sub.images.push_back(block.images[i]);
+        }
+        char file[32];
+        std::snprintf(file, sizeof(file), "group_%03d.ply", index);
+        const PointCloud own = ReadPly(dir / "groups" / file);
+        const SurfaceCheck s = CheckAgainstSurface(own, truth, sub, so);
+        std::cout << std::setw(5) << index << std::setw(8) << sub.images.size() << std::setw(10)
+                  << s.checked << std::fixed << std::setprecision(1) << std::setw(9)
+                  << 100 * s.share_within << "%" << std::setprecision(3) << std::setw(12)
+                  << s.median_abs_dz << std::setprecision(1) << std::setw(9) << 100 * s.coverage
+                  << "%  (" << s.cells_seen << ")\n";
+        std::cout.unsetf(std::ios::floatfield);
+      }
     }
     std::cout << std::setprecision(6) << "cross-group pairs within " << duplicate_gsd
               << " GSD: " << CountCrossGroupPairs(cloud, group_of, duplicate_gsd * gsd) << "\n";

@@ -72,11 +72,11 @@ TEST(BlockGeometry, NgiDemGivesTheExpectedGsd) {
   }
 }
 
-TEST(BlockGeometry, HerzJesuAxesMeetAtTheFacade) {
+TEST(BlockGeometry, HerzJesuTiePointsFindTheFacade) {
   SAPMVS_REQUIRE_PATH(test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8");
   const BlockGeometry g = EstimateBlockGeometry(
       ReadBlock(test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"));
-  EXPECT_EQ(g.source, SurfaceSource::kConvergentAxes);
+  EXPECT_EQ(g.source, SurfaceSource::kTiePoints);
   EXPECT_FALSE(g.aerial);
   EXPECT_EQ(g.num_valid, 8);
   // The facade stands 10 to 30 m from the cameras.

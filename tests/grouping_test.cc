@@ -175,7 +175,15 @@ TEST(GroupingStrips, RemainderOfOneBorrowsFromThePreviousRun) {
   // 13 images: 6 + 6 + 1 would leave an image with nothing to match.
   SimBlock s = MakeSimBlock("campus", false, {0});
   s.block.images.resize(13);
-  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{})), (std::vector<size_t>{6, 5, 2}));
+  // 6 + 5 + 2, and the run of 2 takes image 10 too: a patch needs 3 images
+  // (min_image_num), so a group of 2 would match nothing.
+  const GroupingPlan plan13 = PlanGroups(s.block, GroupingOptions{});
+  EXPECT_EQ(Sizes(plan13), (std::vector<size_t>{6, 5, 3}));
+  EXPECT_EQ(plan13.groups[2].images.front(), plan13.groups[1].images.back());
+  for (const ImageGroup& g : plan13.groups) EXPECT_TRUE(g.short_of_views.empty());
+  GroupingOptions pairs;
+  pairs.min_image_num = 2;
+  EXPECT_EQ(Sizes(PlanGroups(s.block, pairs)), (std::vector<size_t>{6, 5, 2}));
   GroupingOptions two;
   two.max_images = 2;
   s.block.images.resize(5);
@@ -377,9 +385,10 @@ TEST(GroupingMemory, BudgetShortensTheRunsOfAStrip) {
   GroupingOptions o;
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + 1;
   const GroupingPlan plan = PlanGroups(s.block, o);
-  // 16 -> 4+4+4+4, 17 -> 4+4+4+3+2, 18 -> 4+4+4+4+2, 16 -> 4+4+4+4.
+  // 16 -> 4+4+4+4, 17 -> 4+4+4+3+2, 18 -> 4+4+4+4+2, 16 -> 4+4+4+4, each
+  // run of 2 taking the image before it (min_image_num 3).
   EXPECT_EQ(Sizes(plan),
-            (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 2, 4, 4, 4, 4, 2, 4, 4, 4, 4}));
+            (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
   for (const ImageGroup& g : plan.groups) EXPECT_LE(g.memory.Total(), o.memory_budget);
 }
 
@@ -402,6 +411,10 @@ TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {
             std::string::npos);
   EXPECT_NE(problem([](GroupingOptions& o) { o.level = 7; }).find("level = 7"), std::string::npos);
   EXPECT_EQ(problem([](GroupingOptions& o) { o.level = 6; }), "");
+  EXPECT_NE(problem([](GroupingOptions& o) { o.min_image_num = 1; }).find("min_image_num = 1"),
+            std::string::npos);
+  EXPECT_NE(problem([](GroupingOptions& o) { o.min_image_num = 9; }).find("min_image_num = 9"),
+            std::string::npos);
   EXPECT_NE(problem([](GroupingOptions& o) { o.tile_size = 0; }).find("tile_size"),
             std::string::npos);
   EXPECT_NE(problem([](GroupingOptions& o) { o.tile_size = 4.5; }).find("tile_size"),

@@ -10,11 +10,13 @@
 #include <vector>
 
 #include "sapmvs/block.h"
+#include "sapmvs/tie_points.h"
 
 namespace sapmvs {
 
 // Where the scene surface came from, best first.
-enum class SurfaceSource { kDem, kSparsePoints, kGroundHeight, kConvergentAxes, kNone };
+// Tie points (tie_points.h) are derived when a block brings none of the others.
+enum class SurfaceSource { kDem, kSparsePoints, kGroundHeight, kTiePoints, kNone };
 std::string ToString(SurfaceSource source);
 
 struct ImageGeometry {
@@ -37,6 +39,7 @@ struct BlockGeometry {
   double flying_height = 0;  // mean height above the scene (aerial blocks)
   Eigen::Vector3d extent_min = Eigen::Vector3d::Zero();  // bounding box of the footprints
   Eigen::Vector3d extent_max = Eigen::Vector3d::Zero();
+  std::vector<TiePoint> tie_points;  // derived when the block has no other source
 };
 
 // Estimates the scene surface from the best source the block offers.

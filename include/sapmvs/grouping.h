@@ -48,6 +48,11 @@ struct GroupingOptions {
   // of the tile is seen by this many of them (or max_images is reached),
   // >= 2.
   int tile_views = 4;
+  // Images a patch must be photo-consistent in (MatcherOptions::min_image_num),
+  // 2..kMaxViews: a run shorter than this takes the strip images before it,
+  // and images of a group that overlap fewer than min_image_num - 1 others of
+  // it are reported, since they cannot be matched there.
+  int min_image_num = 3;
 
   // Logs the first failing condition to stderr and returns false.
   bool Check() const;
@@ -104,6 +109,9 @@ struct ImageGroup {
   Eigen::Vector2d tile_min = Eigen::Vector2d::Zero();
   Eigen::Vector2d tile_max = Eigen::Vector2d::Zero();
   GroupMemory memory;
+  // Images of the group whose footprint overlaps (>= 10 %) fewer than
+  // min_image_num - 1 others of it.
+  std::vector<int> short_of_views;
 };
 
 struct GroupingPlan {

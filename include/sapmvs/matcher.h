@@ -40,9 +40,11 @@ struct MatcherOptions {
   // Images (reference included) a patch must be photo-consistent in
   // (PMVS2's `minImageNum`), 2 to kMaxViews.
   int min_image_num = 3;
-  // PMVS2's `maxAngle`, degrees: a view takes part in a reference's patches
-  // only if its line of sight meets the reference's at an angle of at least
-  // this (at the scene depth), so that it constrains depth.
+  // PMVS2's `maxAngle`, degrees: a patch is accepted only if some pair of
+  // the images it is matched in (the reference included) meets at it at more
+  // than this (and less than view_angle_deg), so that its depth is
+  // constrained. Each view on its own may be narrower: at the paper's 88 %
+  // forward overlap every neighbour of an image is (4 degrees apart).
   double max_angle_deg = 10.0;
   // Largest angle, degrees, between a patch normal and the direction to an
   // image for that image to be a visible view of the patch.
