@@ -28,6 +28,11 @@ void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global) {
   cmd->add_option("--units", o->units,
                   "Angle unit written to block.yaml: deg, gon or rad (default: the preset's)");
   cmd->add_flag("--cross-strip", o->cross_strip, "Add one strip flown across the others");
+  cmd->add_option("--overlap", o->overlap,
+                  "Forward and side overlap FWD,SIDE in percent of the footprint at the mean "
+                  "ground, e.g. 88,30 (default: the preset's)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   cmd->add_option("--exposure", o->exposure,
                   "Largest relative exposure change between images (default: the preset's)");
   cmd->add_option("--supersampling", o->supersampling, "Rays per pixel side (2 = 2x2)")
@@ -40,8 +45,10 @@ void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global) {
     const SimulateSummary s = Simulate(*o);
     std::cout << "simulated " << s.images << " images of " << s.width << "x" << s.height
               << " px in " << s.strips << " strips, GSD " << s.gsd << " m at " << s.flying_height
-              << " m, " << s.lidar_points << " LiDAR points, angles " << ToString(s.order) << " in "
-              << ToString(s.unit) << "\n"
+              << " m, " << 100 * s.forward_overlap << " % forward and " << 100 * s.side_overlap
+              << " % side overlap (base " << s.base << " m, " << s.neighbour_angle
+              << " deg between neighbours), " << s.lidar_points << " LiDAR points, angles "
+              << ToString(s.order) << " in " << ToString(s.unit) << "\n"
               << "block: " << (o->out / "block.yaml").string() << "\n";
   });
 }

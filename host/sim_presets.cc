@@ -41,13 +41,18 @@ const std::vector<Preset>& AllPresets() {
     }
     {
       // Canon EOS 400D (22.16 x 14.77 mm, 3888 x 2592 px), 24 mm lens, 700 m,
-      // at a quarter of the resolution: 972 x 648 px of 22.8 um.
+      // at a quarter of the resolution: 972 x 648 px of 22.8 um. The paper's
+      // Table 2 steps about 50 m between exposures, and view selection has to
+      // cope with such narrow bases: 50 m is 92.2 % forward overlap of the
+      // 646 m footprint of image x, which flies along track here (the paper's
+      // camera flew its 431 m short side along track: 88 %).
       Preset c;
       c.name = "campus";
       c.description =
-          "the paper's campus: 4 strips of 16, 17, 18 and 16 images (67), 400D at 1/4 resolution";
+          "the paper's campus: 4 strips of 16, 17, 18 and 16 images (67) at 700 m, 50 m bases "
+          "(92.2 % forward, 30 % side overlap), 400D at 1/4 resolution";
       c.camera = {24.0, 22.16 / 972 * 1000, 972, 648};
-      c.flight = {{16, 17, 18, 16}, 700, 0.75, 0.3, 1.5, 0.05};
+      c.flight = {{16, 17, 18, 16}, 700, 0.922, 0.3, 1.5, 0.05};
       c.scene.relief = 6;
       c.scene.relief_wavelength = 900;
       c.scene.road_spacing = 140;
@@ -64,12 +69,17 @@ const std::vector<Preset>& AllPresets() {
       p.push_back(c);
     }
     {
+      // The paper's Table 5: about 1,900 m above the ground (its 0.451 m GSD)
+      // and about 108 m between exposures, 93.9 % of the 1,754 m footprint.
+      // The relief stays a terrain's (220 m against 1,680 m to the highest
+      // peaks still leaves 26 % side overlap there).
       Preset m;
       m.name = "mountain";
       m.description =
-          "the paper's mountain block: large relief, heavy vegetation, few buildings, 125 images";
+          "the paper's mountain block: large relief, heavy vegetation, few buildings; 5 strips x "
+          "25 images (125) at 1900 m, 108 m bases (93.9 % forward, 35 % side overlap)";
       m.camera = {24.0, 22.16 / 972 * 1000, 972, 648};
-      m.flight = {{25, 25, 25, 25, 25}, 1000, 0.8, 0.35, 1.5, 0.05};
+      m.flight = {{25, 25, 25, 25, 25}, 1900, 0.9386, 0.35, 1.5, 0.05};
       m.scene.relief = 220;
       m.scene.relief_wavelength = 2500;
       m.scene.road_spacing = 0;
@@ -120,6 +130,10 @@ Preset FindPreset(const std::string& name) {
   throw Error("unknown preset '" + name + "': expected one of " + names);
 }
 
+double FlightPlan::NeighbourAngleDeg() const {
+  return 2 * std::atan(base / (2 * flying_height)) * 180 / M_PI;
+}
+
 CameraSpec ScaledCamera(const CameraSpec& camera, double scale) {
   CameraSpec c = camera;
   c.width = std::max(16, static_cast<int>(std::lround(camera.width * scale)));
@@ -137,6 +151,13 @@ FlightPlan PlanFlight(const Preset& preset, const CameraSpec& camera, bool cross
   const double along = camera.width * plan.gsd, across = camera.height * plan.gsd;
   const double base = (1 - f.forward_overlap) * along;
   const double spacing = (1 - f.side_overlap) * across;
+  plan.flying_height = f.flying_height;
+  plan.forward_overlap = f.forward_overlap;
+  plan.side_overlap = f.side_overlap;
+  plan.footprint_along = along;
+  plan.footprint_across = across;
+  plan.base = base;
+  plan.strip_spacing = spacing;
   const int longest = *std::max_element(f.images_per_strip.begin(), f.images_per_strip.end());
   const int strips = static_cast<int>(f.images_per_strip.size());
   const double margin = 0.25 * std::max(along, across) + 2 * preset.scene.relief * 0.3;

@@ -19,8 +19,8 @@ struct CameraSpec {
 struct FlightSpec {
   std::vector<int> images_per_strip = {2, 2};
   double flying_height = 120;    // m above the mean ground
-  double forward_overlap = 0.7;  // share of the along-track footprint
-  double side_overlap = 0.35;    // share of the across-track footprint
+  double forward_overlap = 0.7;  // share of the along-track (image x) footprint
+  double side_overlap = 0.35;    // share of the across-track (image y) footprint
   double attitude_noise = 1.5;   // deg, omega and phi; kappa gets 4/3 of it
   double exposure = 0.0;         // largest relative gain change between images
 };
@@ -42,13 +42,6 @@ const std::vector<Preset>& AllPresets();
 
 // Scales the camera's resolution by `scale` (the sensor stays the same).
 CameraSpec ScaledCamera(const CameraSpec& camera, double scale);
-
-struct FlightPlan {
-  std::vector<PlannedImage> images;  // local coordinates (before the world offset)
-  double gsd = 0;
-  double scene_width = 0, scene_height = 0;
-  int strips = 0;
-};
 
 // Lays out strips in alternating directions (kappa 0 flying +X, 180 flying
 // -X), with attitude and position noise, and an optional cross strip (kappa

@@ -93,6 +93,19 @@ std::string Fixed(double v, int precision) {
   return s.str();
 }
 
+std::string Number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// The preset's description names its own overlaps; --overlap replaces them.
+std::string Description(const sim::Preset& preset, const SimulateOptions& o) {
+  if (o.overlap.empty()) return preset.description;
+  return preset.description + ", here flown with --overlap " + Number(o.overlap[0]) + "," +
+         Number(o.overlap[1]);
+}
+
 }  // namespace
 
 namespace sim {
@@ -129,25 +142,48 @@ std::string SimulateOptions::Problem() const {
   if (!(noise >= 0 && noise <= 50))
     return "--noise " + std::to_string(noise) + " is outside 0..50 grey levels";
   if (!(exposure <= 0.5)) return "--exposure " + std::to_string(exposure) + " is above 0.5";
+  if (!overlap.empty()) {
+    if (overlap.size() != 2) {
+      std::string given;
+      for (const double v : overlap) given += (given.empty() ? "" : ",") + Number(v);
+      return "--overlap " + given + ": expected two values FWD,SIDE in percent, e.g. 88,30";
+    }
+    // Beyond these no block is flown: bases or strip spacings of a few
+    // percent of the footprint.
+    if (!(overlap[0] >= 0 && overlap[0] <= 95)) {
+      return "--overlap forward " + Number(overlap[0]) + " % is outside [0, 95]";
+    }
+    if (!(overlap[1] >= 0 && overlap[1] <= 90)) {
+      return "--overlap side " + Number(overlap[1]) + " % is outside [0, 90]";
+    }
+  }
   return "";
 }
 
-SimulatedWorld BuildWorld(const SimulateOptions& o) {
+sim::FlightPlan PlanSimulatedFlight(const SimulateOptions& o) {
   if (const std::string problem = o.Problem(); !problem.empty())
     throw Error("simulate: " + problem);
+  sim::Preset preset = sim::FindPreset(o.preset);
+  if (!o.overlap.empty()) {
+    preset.flight.forward_overlap = o.overlap[0] / 100;
+    preset.flight.side_overlap = o.overlap[1] / 100;
+  }
+  const double exposure = o.exposure >= 0 ? o.exposure : preset.flight.exposure;
+  return sim::PlanFlight(preset, sim::ScaledCamera(preset.camera, o.scale), o.cross_strip, exposure,
+                         o.seed);
+}
+
+SimulatedWorld BuildWorld(const SimulateOptions& o) {
+  sim::FlightPlan plan = PlanSimulatedFlight(o);
   const sim::Preset preset = sim::FindPreset(o.preset);
   const sim::CameraSpec camera = sim::ScaledCamera(preset.camera, o.scale);
-  const double exposure = o.exposure >= 0 ? o.exposure : preset.flight.exposure;
-  const sim::FlightPlan plan = sim::PlanFlight(preset, camera, o.cross_strip, exposure, o.seed);
   sim::SceneSpec spec = preset.scene;
   spec.width = plan.scene_width;
   spec.height = plan.scene_height;
   spec.cell = plan.gsd * preset.cell_per_gsd;
   SimulatedWorld world{sim::Scene::Generate(spec, o.seed),
-                       plan.images,
+                       std::move(plan),
                        {},
-                       plan.gsd,
-                       plan.strips,
                        camera.width,
                        camera.height,
                        camera.focal_mm,
@@ -168,6 +204,7 @@ SimulateSummary Simulate(const SimulateOptions& o) {
     return w;
   }();
   const sim::Scene& scene = world.scene;
+  const sim::FlightPlan& flight = world.flight;
   const Eigen::Vector3d& offset = world.offset;
   fs::create_directories(o.out / "images");
   fs::create_directories(o.out / "truth");
@@ -183,9 +220,9 @@ SimulateSummary Simulate(const SimulateOptions& o) {
   std::ostringstream exposure_txt;
   exposure_txt << "# name gain (the factor each image's linear radiance was multiplied by)\n";
   {
-    Progress p("render", static_cast<long>(world.images.size()), !o.quiet);
-    for (size_t i = 0; i < world.images.size(); ++i) {
-      const PlannedImage& im = world.images[i];
+    Progress p("render", static_cast<long>(flight.images.size()), !o.quiet);
+    for (size_t i = 0; i < flight.images.size(); ++i) {
+      const PlannedImage& im = flight.images[i];
       const Camera cam = Camera::FromAngles(k, im.center, im.omega, im.phi, im.kappa,
                                             AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
       WritePng(o.out / "images" / (im.name + ".png"),
@@ -206,7 +243,7 @@ SimulateSummary Simulate(const SimulateOptions& o) {
 
   std::ostringstream yaml;
   yaml << "# Synthetic block from `sapmvs simulate --preset " << o.preset << " --seed " << o.seed
-       << "`: " << preset.description << ".\n"
+       << "`: " << Description(preset, o) << ".\n"
        << "crs: \"" << kCrs << "\"\n"
        << "dem: truth/dsm.tif\n"
        << "camera:\n  name: " << preset.name << " camera\n"
@@ -242,7 +279,7 @@ SimulateSummary Simulate(const SimulateOptions& o) {
   WriteGeoTiff(o.out / "truth" / "classes.tif", classes);
 
   sim::LidarSpec lidar;
-  lidar.density = sim::LidarDensityForGsd(world.gsd);
+  lidar.density = sim::LidarDensityForGsd(flight.gsd);
   lidar.flying_height = std::max(300.0, 2 * preset.flight.flying_height / 3);
   const double m = 0.1 * std::min(scene.width(), scene.height());
   lidar.min = Eigen::Vector2d(m, m);
@@ -256,17 +293,21 @@ SimulateSummary Simulate(const SimulateOptions& o) {
   WriteLas(o.out / "truth" / "lidar.las", points, las);
   if (o.xyz) WriteXyz(o.out / "truth" / "lidar.xyz", points, 3);
 
-  summary.images = static_cast<int>(world.images.size());
-  summary.strips = world.strips;
+  summary.images = static_cast<int>(flight.images.size());
+  summary.strips = flight.strips;
   summary.width = world.width;
   summary.height = world.height;
-  summary.gsd = world.gsd;
-  summary.flying_height = preset.flight.flying_height;
+  summary.gsd = flight.gsd;
+  summary.flying_height = flight.flying_height;
+  summary.forward_overlap = flight.forward_overlap;
+  summary.side_overlap = flight.side_overlap;
+  summary.base = flight.base;
+  summary.neighbour_angle = flight.NeighbourAngleDeg();
   summary.lidar_points = static_cast<long>(points.size());
 
   std::ostringstream readme;
   readme << "# Synthetic block: " << o.preset << " (seed " << o.seed << ")\n\n"
-         << preset.description << ".\n\n"
+         << Description(preset, o) << ".\n\n"
          << "- `block.yaml`, `orientation.txt`: the block (" << summary.images << " images of "
          << world.width << "x" << world.height << " px in " << summary.strips << " strips; angles "
          << ToString(summary.order) << " in " << ToString(summary.unit) << "; CRS " << kCrs
@@ -284,9 +325,17 @@ SimulateSummary Simulate(const SimulateOptions& o) {
          << "2 cm vertical and 5 cm horizontal noise; classes 2 ground, 5 vegetation, 6 building, "
             "9 water.\n"
          << "- `truth/exposure.txt`: each image's exposure gain.\n\n"
-         << "Nominal GSD " << Fixed(world.gsd, 4) << " m at " << preset.flight.flying_height
+         << "Nominal GSD " << Fixed(flight.gsd, 4) << " m at " << flight.flying_height
          << " m above the mean ground; world = local + (" << Fixed(offset.x(), 0) << ", "
-         << Fixed(offset.y(), 0) << ", " << Fixed(offset.z(), 0) << ").\n";
+         << Fixed(offset.y(), 0) << ", " << Fixed(offset.z(), 0) << ").\n\n"
+         << "Flight: " << Fixed(100 * flight.forward_overlap, 1) << " % forward and "
+         << Fixed(100 * flight.side_overlap, 1) << " % side overlap"
+         << (o.overlap.empty() ? " (the preset's)" : " (--overlap)") << " of the "
+         << Fixed(flight.footprint_along, 1) << " x " << Fixed(flight.footprint_across, 1)
+         << " m footprint (image x along track) at the mean ground: a base of "
+         << Fixed(flight.base, 2) << " m between neighbours of a strip ("
+         << Fixed(flight.NeighbourAngleDeg(), 2) << " deg between their rays to the ground "
+         << "midway), strips " << Fixed(flight.strip_spacing, 2) << " m apart.\n";
   WriteText(o.out / "truth" / "README.md", readme.str());
   return summary;
 }

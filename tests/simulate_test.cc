@@ -2,17 +2,20 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <sstream>
 
+#include "cli_test_util.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
 #include "sapmvs/las_io.h"
 #include "sapmvs/raster_io.h"
+#include "sim_presets.h"
 #include "test_util.h"
 
 namespace sapmvs {
@@ -219,6 +222,11 @@ TEST(Simulate, TruthFilesAreValidAndAgree) {
   }
   ASSERT_GT(total, 10000);
   EXPECT_GT(static_cast<double>(agree) / total, 0.95) << agree << " of " << total;
+  // The README says how the block was flown.
+  const std::string readme = Slurp(dir / "truth" / "README.md");
+  EXPECT_NE(readme.find("70.0 % forward and 35.0 % side overlap (the preset's)"), std::string::npos)
+      << readme;
+  EXPECT_NE(readme.find("a base of 52.36 m"), std::string::npos) << readme;
 }
 
 TEST(Simulate, AngleFlagsChangeTheFileNotTheCameras) {
@@ -258,8 +266,7 @@ TEST(Simulate, PresetsDescribeThePapersBlocks) {
   SimulateOptions campus;
   campus.preset = "campus";
   campus.out = "unused";
-  campus.scale = 0.02;
-  const SimulatedWorld w = BuildWorld(campus);
+  const sim::FlightPlan w = PlanSimulatedFlight(campus);
   EXPECT_EQ(w.images.size(), 67u);
   EXPECT_EQ(w.strips, 4);
   int per_strip[4] = {0, 0, 0, 0};
@@ -275,9 +282,9 @@ TEST(Simulate, CrossStripFliesAcrossTheOthers) {
   o.preset = "small";
   o.out = "unused";
   o.scale = 0.1;  // plans only
-  const SimulatedWorld plain = BuildWorld(o);
+  const sim::FlightPlan plain = PlanSimulatedFlight(o);
   o.cross_strip = true;
-  const SimulatedWorld cross = BuildWorld(o);
+  const sim::FlightPlan cross = PlanSimulatedFlight(o);
   EXPECT_EQ(cross.strips, plain.strips + 1);
   ASSERT_GT(cross.images.size(), plain.images.size() + 1);
   // The added images fly along +Y: kappa near 90 deg, x fixed, y increasing.
@@ -285,6 +292,142 @@ TEST(Simulate, CrossStripFliesAcrossTheOthers) {
   const PlannedImage& b = cross.images.back();
   EXPECT_NEAR(a.kappa, 90, 3);
   EXPECT_GT(b.center.y() - a.center.y(), 10 * std::abs(b.center.x() - a.center.x()));
+}
+
+// Mean step between consecutive exposures along a strip, and between the
+// mean centres of neighbouring strips, from the planned cameras alone.
+struct Spacings {
+  double base = 0, strips = 0;
+};
+Spacings MeasureSpacings(const sim::FlightPlan& plan) {
+  std::map<int, std::vector<Eigen::Vector3d>> by_strip;
+  for (const PlannedImage& im : plan.images) by_strip[im.strip].push_back(im.center);
+  Spacings s;
+  int pairs = 0;
+  std::vector<double> strip_y;
+  for (const auto& [strip, centres] : by_strip) {
+    // Along the strip only: the cross-track position noise says nothing
+    // about the base.
+    const Eigen::Vector3d along = (centres.back() - centres.front()).normalized();
+    double y = 0;
+    for (size_t i = 0; i < centres.size(); ++i) {
+      y += centres[i].y();
+      if (i == 0) continue;
+      s.base += along.dot(centres[i] - centres[i - 1]);
+      ++pairs;
+    }
+    strip_y.push_back(y / centres.size());
+  }
+  s.base /= pairs;
+  for (size_t k = 1; k < strip_y.size(); ++k) s.strips += strip_y[k] - strip_y[k - 1];
+  s.strips /= strip_y.size() - 1;
+  return s;
+}
+
+// Footprint of the preset's sensor on the mean ground, image x (along track)
+// and image y, from the camera's data sheet rather than the plan.
+Eigen::Vector2d Footprint(const std::string& preset) {
+  const sim::Preset p = sim::FindPreset(preset);
+  const double scale = p.flight.flying_height / p.camera.focal_mm * 1e-3;
+  return Eigen::Vector2d(p.camera.width, p.camera.height) * p.camera.pixel_um * scale;
+}
+
+TEST(Simulate, OverlapFlagSetsBaseAndStripSpacing) {
+  for (const std::string preset : {"small", "campus", "mountain"}) {
+    const Eigen::Vector2d footprint = Footprint(preset);
+    for (const auto& [forward, side] : {std::pair{88.0, 30.0}, {60.0, 20.0}, {95.0, 0.0}}) {
+      SimulateOptions o;
+      o.preset = preset;
+      o.out = "unused";
+      o.overlap = {forward, side};
+      const sim::FlightPlan plan = PlanSimulatedFlight(o);
+      const Spacings measured = MeasureSpacings(plan);
+      const double base = (1 - forward / 100) * footprint.x();
+      const double spacing = (1 - side / 100) * footprint.y();
+      EXPECT_NEAR(measured.base, base, 0.03 * base) << preset << " " << forward;
+      EXPECT_NEAR(measured.strips, spacing, 0.03 * spacing) << preset << " " << side;
+      EXPECT_NEAR(plan.base, base, 1e-6 * base);
+      EXPECT_NEAR(plan.forward_overlap, forward / 100, 1e-12);
+      EXPECT_NEAR(plan.side_overlap, side / 100, 1e-12);
+    }
+  }
+  // The preset's own overlaps given as a flag fly the very same cameras.
+  SimulateOptions o;
+  o.preset = "tiny";
+  o.out = "unused";
+  const sim::FlightPlan preset = PlanSimulatedFlight(o);
+  o.overlap = {70, 35};
+  const sim::FlightPlan given = PlanSimulatedFlight(o);
+  ASSERT_EQ(given.images.size(), preset.images.size());
+  for (size_t i = 0; i < given.images.size(); ++i) {
+    EXPECT_EQ(given.images[i].center, preset.images[i].center);
+    EXPECT_EQ(given.images[i].kappa, preset.images[i].kappa);
+  }
+}
+
+TEST(Simulate, CampusAndMountainFlyThePapersBases) {
+  // Table 2: about 50 m between exposures at 700 m; Table 5: about 108 m
+  // at about 1,900 m (GSD 0.451 m at full resolution).
+  const struct {
+    const char* preset;
+    double height, base, angle;
+  } blocks[] = {{"campus", 700, 50, 4.1}, {"mountain", 1900, 108, 3.25}};
+  for (const auto& b : blocks) {
+    SimulateOptions o;
+    o.preset = b.preset;
+    o.out = "unused";
+    const sim::FlightPlan plan = PlanSimulatedFlight(o);
+    double z = 0;
+    for (const PlannedImage& im : plan.images) z += im.center.z();
+    EXPECT_NEAR(z / plan.images.size(), b.height, 0.005 * b.height) << b.preset;
+    const double base = MeasureSpacings(plan).base;
+    EXPECT_NEAR(base, b.base, 0.03 * b.base) << b.preset;
+    const double angle = 2 * std::atan(base / (2 * b.height)) * 180 / M_PI;
+    EXPECT_NEAR(angle, b.angle, 0.1) << b.preset;
+    EXPECT_NEAR(plan.NeighbourAngleDeg(), b.angle, 0.1) << b.preset;
+    std::cout << "[ sim ] " << b.preset << ": " << 100 * plan.forward_overlap << " % forward, "
+              << 100 * plan.side_overlap << " % side overlap at " << plan.flying_height
+              << " m; base " << base << " m measured (" << plan.base << " planned), " << angle
+              << " deg between neighbours; strips " << plan.strip_spacing << " m apart\n";
+  }
+  SimulateOptions mountain;
+  mountain.preset = "mountain";
+  mountain.out = "unused";
+  EXPECT_NEAR(PlanSimulatedFlight(mountain).gsd * 972 / 3888, 0.451, 0.01);
+}
+
+TEST(Simulate, BadOverlapIsRefusedInOneLine) {
+  const struct {
+    std::vector<double> overlap;
+    const char* says;
+  } cases[] = {{{96, 30}, "forward 96 % is outside [0, 95]"},
+               {{-1, 30}, "forward -1 % is outside [0, 95]"},
+               {{NAN, 30}, "forward nan % is outside [0, 95]"},
+               {{88, 91}, "side 91 % is outside [0, 90]"},
+               {{88, -0.5}, "side -0.5 % is outside [0, 90]"},
+               {{88}, "--overlap 88: expected two values"},
+               {{88, 30, 10}, "--overlap 88,30,10: expected two values"}};
+  for (const auto& c : cases) {
+    SimulateOptions o = Tiny("unused");
+    o.overlap = c.overlap;
+    const std::string problem = o.Problem();
+    EXPECT_NE(problem.find(c.says), std::string::npos) << problem;
+    EXPECT_EQ(problem.find('\n'), std::string::npos) << problem;
+    EXPECT_THROW(PlanSimulatedFlight(o), Error);
+  }
+  for (const auto& good : {std::vector<double>{0, 0}, {95, 90}, {88, 30}}) {
+    SimulateOptions o = Tiny("unused");
+    o.overlap = good;
+    EXPECT_EQ(o.Problem(), "");
+  }
+  // The command line refuses before anything is written.
+  const fs::path out = test::ScratchDir() / "refused";
+  const test::CliResult r =
+      test::RunCli("simulate --preset tiny --overlap 96,30 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("--overlap forward 96 % is outside [0, 95]"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Simulate, BadOptionsAreRejected) {

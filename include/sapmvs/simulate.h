@@ -24,11 +24,15 @@ struct SimulateOptions {
   std::string angles;  // angle order written to block.yaml; empty = the preset's
   std::string units;   // angle unit written to block.yaml; empty = the preset's
   bool cross_strip = false;  // add one strip flown across the others
-  double exposure = -1;      // largest relative exposure change between images; < 0 = the preset's
-  int supersampling = 2;     // rays per pixel side (2 = 2x2 per pixel), at least 2
-  double noise = 1.5;        // sensor noise, standard deviation in 8-bit grey levels
-  bool xyz = false;          // also write truth/lidar.xyz
-  bool quiet = false;        // no progress bar
+  // Forward and side overlap, percent of the footprint at the mean ground
+  // (e.g. {88, 30}); empty = the preset's. The base is (1 - forward) x the
+  // along-track footprint, the strip spacing (1 - side) x the across-track one.
+  std::vector<double> overlap;
+  double exposure = -1;   // largest relative exposure change between images; < 0 = the preset's
+  int supersampling = 2;  // rays per pixel side (2 = 2x2 per pixel), at least 2
+  double noise = 1.5;     // sensor noise, standard deviation in 8-bit grey levels
+  bool xyz = false;       // also write truth/lidar.xyz
+  bool quiet = false;     // no progress bar
 
   // Empty when the options are usable, else one line naming the bad value.
   std::string Problem() const;
@@ -46,12 +50,42 @@ struct PlannedImage {
   double gain = 1;  // exposure factor
 };
 
+namespace sim {
+
+// The flight of a block: where each image is taken, and the geometry the
+// overlaps give it. Image x (the sensor's long side for the presets' cameras)
+// lies along track, as rotation.h's convention has it.
+struct FlightPlan {
+  std::vector<PlannedImage> images;  // local coordinates (before the world offset)
+  int strips = 0;
+  double gsd = 0;                                    // nominal, at the mean ground
+  double flying_height = 0;                          // m above the mean ground
+  double forward_overlap = 0, side_overlap = 0;      // shares of the footprint
+  double footprint_along = 0, footprint_across = 0;  // m on the mean ground
+  double base = 0;           // m between neighbouring exposures of a strip, before noise
+  double strip_spacing = 0;  // m between neighbouring strips
+  double scene_width = 0, scene_height = 0;  // m, covering every footprint with a margin
+
+  // Degrees between the rays of two neighbours of a strip to the ground point
+  // midway below them: what narrow baselines make small.
+  double NeighbourAngleDeg() const;
+};
+
+}  // namespace sim
+
+// The flight Simulate flies for `options`, planned without the scene or any
+// rendering (cheap, also for the big presets). Throws on bad options.
+sim::FlightPlan PlanSimulatedFlight(const SimulateOptions& options);
+
 struct SimulateSummary {
   int images = 0;
   int strips = 0;
   int width = 0, height = 0;
   double gsd = 0;  // nominal, at the mean ground height
   double flying_height = 0;
+  double forward_overlap = 0, side_overlap = 0;  // shares of the footprint
+  double base = 0;                               // m between neighbours of a strip
+  double neighbour_angle = 0;                    // deg, see FlightPlan
   long lidar_points = 0;
   AngleOrder order = AngleOrder::kOmegaPhiKappa;
   AngleUnit unit = AngleUnit::kDegree;
@@ -61,10 +95,8 @@ struct SimulateSummary {
 // `options`: tests rebuild them to compare the outputs with the truth.
 struct SimulatedWorld {
   sim::Scene scene;
-  std::vector<PlannedImage> images;  // local coordinates
-  Eigen::Vector3d offset;            // world = local + offset
-  double gsd = 0;                    // nominal, at the mean ground
-  int strips = 0;
+  sim::FlightPlan flight;     // the images, in local coordinates
+  Eigen::Vector3d offset;     // world = local + offset
   int width = 0, height = 0;  // image size, px
   double focal_mm = 0, pixel_um = 0;
 };
