@@ -123,5 +123,47 @@ TEST_F(PatchEngineTest, RejectsSeedsWithTooFewViewsOrFacingAway) {
   for (const auto& r : engine.Evaluate(TiltedSeeds(scene, 4, 0.0, 0.0, 94))) EXPECT_FALSE(r);
 }
 
+// The paper's narrow baselines: 5 images 4 degrees apart along a strip
+// (2.8 m at 40 m). Every view of the middle image is narrower than
+// max_angle (10 degrees), yet the views on either side of it are 12 to 16
+// degrees apart, so patches are accepted (PMVS2's checkAngles); in a strip
+// 0.5 degree apart, no pair of images reaches 10 degrees and every patch is
+// rejected, however well it scores.
+TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
+  MatcherOptions options;
+  options.mode = MatchMode::kPmvs;
+  options.adaptive_sizes = {options.window_size};
+  ASSERT_EQ(options.max_angle_deg, 10.0);
+  const double base = 40.0 * std::tan(4.0 * kPiRad / 180.0);
+  const PlaneScene strip = MakePlaneScene(5, 201, 161, 96, base);
+  MatchGroupData group = GroupOf(strip);
+  for (MatchImage& im : group.images) im.depth = 40.0;
+  SelectViews(options, &group);
+  EXPECT_EQ(group.images[0].views.size(), 4u);  // none dropped for being narrow
+  {
+    PatchEngine engine(context(), group, options);
+    int accepted = 0;
+    for (const auto& r : engine.Evaluate(TiltedSeeds(strip, 8, 0.5, 3.0, 97))) {
+      if (!r) continue;
+      ++accepted;
+      const Camera& ref = strip.cameras[0];
+      const Eigen::Vector3d truth = GroundAt(ref, ref.Project(r->center));
+      EXPECT_LT(std::abs(ref.Depth(r->center) - ref.Depth(truth)) / Footprint(ref, truth), 0.5);
+    }
+    EXPECT_EQ(accepted, 8);
+  }
+  const PlaneScene narrow = MakePlaneScene(5, 201, 161, 96, 40.0 * std::tan(0.5 * kPiRad / 180.0));
+  const MatchGroupData narrow_group = GroupOf(narrow);
+  PatchEngine engine(context(), narrow_group, options);
+  for (const auto& r : engine.Evaluate(TiltedSeeds(narrow, 8, 0.0, 0.0, 97))) EXPECT_FALSE(r);
+  // The same seeds pass once max_angle allows the pairs' 1 to 2 degrees.
+  options.max_angle_deg = 0.8;
+  PatchEngine lenient(context(), narrow_group, options);
+  int accepted = 0;
+  for (const auto& r : lenient.Evaluate(TiltedSeeds(narrow, 8, 0.0, 0.0, 97)))
+    accepted += r.has_value();
+  EXPECT_EQ(accepted, 8);
+}
+
 }  // namespace
 }  // namespace sapmvs

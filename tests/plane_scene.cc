@@ -5,7 +5,7 @@
 
 namespace sapmvs::test {
 
-PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed) {
+PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed, double strip_base) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   PlaneScene scene;
@@ -23,7 +23,12 @@ PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed) 
   const Intrinsics intrinsics = Intrinsics::FromPixels(150.0, 152.0, 0.5 * (width - 1) + 2.0,
                                                        0.5 * (height - 1) - 1.5, width, height);
   for (int i = 0; i < num_images; ++i) {
-    const Eigen::Vector3d center(6.0 * unit(rng), 6.0 * unit(rng), 40.0 + 3.0 * unit(rng));
+    Eigen::Vector3d center(6.0 * unit(rng), 6.0 * unit(rng), 40.0 + 3.0 * unit(rng));
+    if (strip_base > 0) {
+      // 0, -b, +b, -2b, +2b, ... along x at 40 m: image 0 in the middle.
+      const int step = (i + 1) / 2;
+      center = Eigen::Vector3d((i % 2 ? -1.0 : 1.0) * step * strip_base, 0.0, 40.0);
+    }
     // Nadir (camera x = world x, y = -world y, z down), then a yaw and a tilt
     // of up to about 12 degrees.
     Eigen::Matrix3d r_cw;

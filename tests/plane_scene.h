@@ -29,8 +29,10 @@ struct PlaneScene {
 };
 
 // `num_images` cameras of `width` x `height` px over the plane, deterministic
-// for `seed`.
-PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed);
+// for `seed`. With `strip_base` > 0 (m), the centres lie on a strip along x
+// at 40 m, that far apart, image 0 in the middle (0, -b, +b, -2b, ...).
+PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed,
+                          double strip_base = 0);
 
 // Ground point (z = 0) seen at pixel `uv` of `camera`.
 Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv);
