@@ -70,10 +70,11 @@ void PrintInfo(const Block& block, std::ostream& out) {
   if (g.source == SurfaceSource::kSparsePoints)
     out << " (" << block.sparse_points.size() << " points)";
   if (g.source == SurfaceSource::kGroundHeight) out << Fmt(" (Z = %.3f)", *block.ground_height);
+  if (g.source == SurfaceSource::kTiePoints) out << " (" << g.tie_points.size() << " points)";
   out << "\n";
   if (g.num_valid == 0) {
-    out << "GSD            unknown: no surface estimate (add ground_height or dem to a "
-           "block.yaml)\n";
+    out << "GSD            unknown: no surface estimate (no DEM, sparse points or ground "
+           "height, and too few tie points; give --ground-height)\n";
     return;
   }
   out << "GSD            "
