@@ -1,8 +1,11 @@
 #include "sapmvs/atomic_file.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -62,6 +65,34 @@ void WriteFileAtomically(const std::filesystem::path& path,
   AtomicFile file(path);
   write(file.temp_path());
   file.Commit();
+}
+
+void WriteBytesAtomically(const std::filesystem::path& path, const void* data, std::size_t size) {
+  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw Error(path.string() + ": cannot write (" + std::strerror(errno) + ")");
+    const char* p = static_cast<const char*>(data);
+    std::size_t left = size;
+    int err = 0;
+    while (left > 0 && err == 0) {
+      const ssize_t n = ::write(fd, p, left);
+      if (n > 0) {
+        p += n;
+        left -= static_cast<std::size_t>(n);
+      } else if (n < 0 && errno != EINTR) {
+        err = errno;
+      } else if (n == 0) {
+        err = EIO;
+      }
+    }
+    if (err == 0 && ::fsync(fd) != 0) err = errno;
+    if (::close(fd) != 0 && err == 0) err = errno;
+    if (err != 0) throw Error(path.string() + ": write failed (" + std::strerror(err) + ")");
+  });
+}
+
+void WriteTextAtomically(const std::filesystem::path& path, const std::string& text) {
+  WriteBytesAtomically(path, text.data(), text.size());
 }
 
 }  // namespace sapmvs

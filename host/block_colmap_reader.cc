@@ -4,12 +4,15 @@
 //                of 2D points (possibly empty) per image
 //   x_cam = R(q) X + t, OpenCV camera frame. COLMAP puts pixel centres at
 //   half-integers (the image corner is 0, 0), so 0.5 is taken off cx and cy.
+// A project `sapmvs export` wrote is in the block's local frame; its side file
+// (export_frame.h), at the project's root, puts it back into the world frame.
 
 #include <Eigen/Geometry>
 #include <map>
 
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
+#include "sapmvs/export_frame.h"
 #include "sapmvs/image_io.h"
 #include "text_lines.h"
 
@@ -77,10 +80,27 @@ fs::path ModelDir(const fs::path& given) {
   return given;
 }
 
+// The export's root holds sparse/0 (or is the model folder itself).
+fs::path ExportRoot(const fs::path& model_dir) {
+  // Absolute, so that a relative model folder's parents are real folders.
+  fs::path dir = fs::absolute(model_dir).lexically_normal();
+  if (!dir.has_filename()) dir = dir.parent_path();  // a trailing slash
+  for (const fs::path& cand : {dir, dir.parent_path(), dir.parent_path().parent_path()}) {
+    if (fs::is_regular_file(cand / kExportFrameFile) ||
+        fs::is_regular_file(cand / kExportMarkerFile)) {
+      return cand;
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
   const fs::path dir = ModelDir(given);
+  const fs::path export_root = ExportRoot(dir);
+  const std::optional<ExportFrame> frame =
+      export_root.empty() ? std::nullopt : ReadExportFrame(export_root);
   std::map<int, Intrinsics> cameras;
   {
     TextLines lines(dir / "cameras.txt");
@@ -147,6 +167,7 @@ Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
                                        pts.Double(t[3], "Z"));
     }
   }
+  if (frame) ApplyExportFrame(*frame, export_root, "colmap", &block);
   return block;
 }
 

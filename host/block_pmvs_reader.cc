@@ -2,12 +2,15 @@
 //   txt/NNNNNNNN.txt   "CONTOUR" then the 3x4 projection matrix (3 rows)
 //   visualize/NNNNNNNN.jpg (or .ppm/.png), already undistorted
 // The image size is not in the text file: it comes from the image header.
+// A folder `sapmvs export` wrote is in the block's local frame; its side file
+// (export_frame.h) puts the cameras back into the world frame.
 
 #include <algorithm>
 #include <cctype>
 
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
+#include "sapmvs/export_frame.h"
 #include "sapmvs/image_io.h"
 #include "text_lines.h"
 
@@ -18,6 +21,7 @@ Block ReadPmvsBlock(const fs::path& given, const BlockReadOptions& options) {
   const fs::path root = fs::is_regular_file(given) ? given.parent_path().parent_path() : given;
   const fs::path txt = root / "txt";
   if (!fs::is_directory(txt)) throw Error(root.string() + ": no txt/ folder (PMVS layout)");
+  const std::optional<ExportFrame> frame = ReadExportFrame(root);
   const fs::path image_dir = options.image_dir.empty() ? root / "visualize" : options.image_dir;
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(txt)) {
@@ -63,6 +67,7 @@ Block ReadPmvsBlock(const fs::path& given, const BlockReadOptions& options) {
     }
     block.images.push_back(std::move(im));
   }
+  if (frame) ApplyExportFrame(*frame, root, "pmvs", &block);
   return block;
 }
 

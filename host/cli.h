@@ -28,7 +28,9 @@ struct BlockFlags {
   BlockReadOptions read;
   double ground_height = std::numeric_limits<double>::quiet_NaN();
 };
-void AddBlockFlags(CLI::App* cmd, BlockFlags* flags);
+// `format_flag` names the block format's flag: "--input-format" where
+// --format names what a subcommand writes (export).
+void AddBlockFlags(CLI::App* cmd, BlockFlags* flags, const std::string& format_flag = "--format");
 // The flags as BlockReadOptions; throws Error for an unknown format.
 BlockReadOptions ReadOptionsOf(const BlockFlags& flags);
 // Reads `path` as the flags say; throws Error for a bad flag value.
@@ -40,5 +42,6 @@ void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterRunCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterPlanCommand(CLI::App& app, const GlobalFlags& global);
+void RegisterExportCommand(CLI::App& app, const GlobalFlags& global);
 
 }  // namespace sapmvs::cli

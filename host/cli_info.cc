@@ -118,8 +118,8 @@ void RegisterInfoCommand(CLI::App& app, const GlobalFlags& /*global*/) {
   });
 }
 
-void AddBlockFlags(CLI::App* cmd, BlockFlags* flags) {
-  cmd->add_option("--format", flags->format,
+void AddBlockFlags(CLI::App* cmd, BlockFlags* flags, const std::string& format_flag) {
+  cmd->add_option(format_flag, flags->format,
                   "Block format: auto, yaml, pmvs, colmap, strecha, opensfm")
       ->capture_default_str();
   cmd->add_option("--image-dir", flags->read.image_dir,

@@ -397,8 +397,8 @@ std::string GroupingOptions::Problem() const {
     s << "max_images >= 2 (max_images = " << max_images << ")";
   else if (!(memory_budget > 0 && std::isfinite(memory_budget)))
     s << "memory_budget > 0 bytes (memory_budget = " << memory_budget << ")";
-  else if (level < 0 || level > 6)
-    s << "level in 0..6 (level = " << level << ")";
+  else if (level < 0 || level > kMaxLevel)
+    s << "level in 0.." << kMaxLevel << " (level = " << level << ")";
   else if (!(tile_size > 0 && tile_size <= 4))
     s << "tile_size in (0, 4] (tile_size = " << tile_size << ")";
   else if (tile_views < 2)
@@ -422,8 +422,9 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
 
 GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images,
                                 const MatcherOptions& matcher) {
-  if (matcher.level < 0 || matcher.level > 6)
-    throw Error("memory estimate: level in 0..6 expected, got " + std::to_string(matcher.level));
+  if (matcher.level < 0 || matcher.level > kMaxLevel)
+    throw Error("memory estimate: level in 0.." + std::to_string(kMaxLevel) + " expected, got " +
+                std::to_string(matcher.level));
   const double views = kMaxViews - 1;
   const double cs = std::max(1, matcher.cell_size);
   const double per_cell =

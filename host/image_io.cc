@@ -107,4 +107,17 @@ LoadedImage LoadUndistorted(const BlockImage& image) {
   return out;
 }
 
+cv::Mat ResampleToLevel(const cv::Mat& image, int level, int width, int height) {
+  cv::Mat out = image;
+  for (int l = 0; l < level; ++l) {
+    cv::Mat half;
+    cv::resize(out, half, cv::Size((out.cols + 1) / 2, (out.rows + 1) / 2), 0, 0, cv::INTER_AREA);
+    out = half;
+  }
+  if (out.cols != width || out.rows != height) {
+    cv::resize(out, out, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  }
+  return out;
+}
+
 }  // namespace sapmvs

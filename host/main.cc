@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   sapmvs::cli::RegisterRunCommand(app, global);
   sapmvs::cli::RegisterPlanCommand(app, global);
   sapmvs::cli::RegisterEvaluateCommand(app, global);
+  sapmvs::cli::RegisterExportCommand(app, global);
 
   try {
     app.parse(argc, argv);

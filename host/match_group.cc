@@ -45,18 +45,8 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     im.name = bi.name;
     im.block_index = id;
     im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
-    cv::Mat bgr = loaded.pixels;
-    for (int l = 0; l < level; ++l) {
-      // INTER_AREA at exactly 1/2 averages 2x2 blocks: output pixel i is
-      // centred at input 2i + 0.5, which is Intrinsics::Scaled's convention
-      // (pyrDown would centre it at 2i).
-      cv::Mat half;
-      cv::resize(bgr, half, cv::Size((bgr.cols + 1) / 2, (bgr.rows + 1) / 2), 0, 0, cv::INTER_AREA);
-      bgr = half;
-    }
-    if (bgr.cols != im.camera.width() || bgr.rows != im.camera.height()) {
-      cv::resize(bgr, bgr, cv::Size(im.camera.width(), im.camera.height()), 0, 0, cv::INTER_AREA);
-    }
+    const cv::Mat bgr =
+        ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
     im.color = bgr;
     cv::Mat grey8;
     cv::cvtColor(bgr, grey8, cv::COLOR_BGR2GRAY);

@@ -24,8 +24,8 @@ namespace {
 
 std::string FirstProblem(const MatcherOptions& o) {
   std::ostringstream s;
-  if (o.level < 0 || o.level > 6)
-    s << "level in 0..6 (level = " << o.level << ")";
+  if (o.level < 0 || o.level > kMaxLevel)
+    s << "level in 0.." << kMaxLevel << " (level = " << o.level << ")";
   else if (o.cell_size < 1 || o.cell_size > 16)
     s << "cell_size in 1..16 (cell_size = " << o.cell_size << ")";
   else if (!(o.threshold > -1 && o.threshold <= 1))

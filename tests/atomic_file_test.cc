@@ -119,5 +119,22 @@ TEST_F(AtomicFileTest, CommitWithoutTempFileThrowsAndKeepsTheOldFile) {
 
 TEST_F(AtomicFileTest, DirectoryAsPathIsRefused) { EXPECT_THROW(AtomicFile file(dir_), Error); }
 
+TEST_F(AtomicFileTest, WriteBytesAndTextReplaceTheFileWhole) {
+  const fs::path path = dir_ / "image.bin";
+  Spit(path, "old contents, longer than the new");
+  const std::string bytes("a\0b\n", 4);  // binary-safe: keeps the NUL
+  WriteBytesAtomically(path, bytes.data(), bytes.size());
+  EXPECT_EQ(Slurp(path), bytes);
+  WriteTextAtomically(path, "");
+  EXPECT_EQ(fs::file_size(path), 0u);
+  EXPECT_EQ(FileCount(), 1);  // no temp file left
+  try {
+    WriteTextAtomically(dir_ / "missing" / "x.txt", "x");
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace sapmvs

@@ -5,8 +5,10 @@
 // destination's directory and rename it onto the destination, which POSIX
 // makes atomic within one file system.
 
+#include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <string>
 
 namespace sapmvs {
 
@@ -43,5 +45,12 @@ class AtomicFile {
 // `write` throws, the exception propagates and neither file is left behind.
 void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(const std::filesystem::path& tmp)>& write);
+
+// Writes `size` bytes (an encoded image, a text) to `path` atomically, flushed
+// to the disk (fsync) before the rename: after a crash the name then holds the
+// old file or the whole new one, never an empty one. Throws sapmvs::Error
+// naming `path`.
+void WriteBytesAtomically(const std::filesystem::path& path, const void* data, std::size_t size);
+void WriteTextAtomically(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace sapmvs

@@ -43,4 +43,11 @@ struct LoadedImage {
 };
 LoadedImage LoadUndistorted(const BlockImage& image);
 
+// `image` at pyramid level `level`, to go with Camera::Scaled(2^-level) of
+// size `width` x `height`: halved `level` times by averaging 2x2 blocks
+// (INTER_AREA at exactly 1/2), so that output pixel i is centred at input
+// 2i + 0.5 as Intrinsics::Scaled assumes (pyrDown would centre it at 2i),
+// then resized to the camera's size where the rounding of odd sides differs.
+cv::Mat ResampleToLevel(const cv::Mat& image, int level, int width, int height);
+
 }  // namespace sapmvs

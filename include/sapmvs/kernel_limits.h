@@ -36,6 +36,11 @@ inline constexpr int kMaxViews = 8;
 // be addressed exactly.
 inline constexpr int kMaxImageSide = 1 << 24;
 
+// Deepest pyramid level (0 = full resolution, each level halves both sides)
+// that matching, planning and export accept: 1/64 of a 10,000-pixel side is
+// still a usable image.
+inline constexpr int kMaxLevel = 6;
+
 // Patch refinement (kernels/patch_refine.cl, PatchRefinerOptions). Each
 // iteration scores 6 candidates (+- one step on depth, yaw and pitch) and
 // halves the steps when none improves. 24 iterations take the tests' patches
