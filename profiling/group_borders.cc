@@ -79,6 +79,10 @@ int main(int argc, char** argv) {
                  "Take the group centres from this run instead (e.g. to measure a one-group "
                  "run over the zones of a grouped one)");
   app.add_option("--level", level, "Pyramid level matched (coverage cells)")->capture_default_str();
+  double tolerance_gsd = 1;
+  app.add_option("--tolerance", tolerance_gsd,
+                 "Height tolerance of a right point (and of a covered cell), block GSDs")
+      ->capture_default_str();
   bool per_group = false;
   app.add_flag("--per-group", per_group,
                "Also each group's checkpoint cloud against the cells its own images see");
@@ -102,14 +106,14 @@ int main(int argc, char** argv) {
     const double gsd = EstimateBlockGeometry(block).gsd_median;
     const double band = band_gsd * gsd;
     SurfaceCheckOptions so;
-    so.tolerance = gsd;
+    so.tolerance = tolerance_gsd * gsd;
     so.cell_size = 2 * std::ldexp(1.0, level) * gsd;
     const std::optional<GeoRaster> classes = ReadClassRasterBeside(truth_path);
     if (classes) so.classes = &*classes;
     std::cout << "run " << run_dir << ": " << cloud.points.size() << " points, " << centers.size()
               << " groups; GSD " << gsd << ", border band +-" << band << " (" << band_gsd
-              << " GSD)\n";
-    std::cout << "zone        points   <=1 GSD  median|dz|  coverage  (cells seen)\n";
+              << " GSD); within = within " << tolerance_gsd << " GSD\n";
+    std::cout << "zone        points    within  median|dz|  coverage  (cells seen)\n";
     for (const bool border : {true, false}) {
       so.region = [&](double x, double y) {
         return centers.size() > 1 && (DistanceToCoreBoundary(centers, x, y) <= band) == border;
@@ -126,7 +130,7 @@ int main(int argc, char** argv) {
     }
     if (per_group) {
       so.region = nullptr;
-      std::cout << "group  images    points   <=1 GSD  median|dz|  coverage  (cells seen by "
+      std::cout << "group  images    points    within  median|dz|  coverage  (cells seen by "
                 << so.min_images << "+ of its images)\n";
       for (const auto& g : report.at("groups")) {
         const int index = g.at("group").get<int>();
