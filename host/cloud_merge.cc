@@ -193,4 +193,19 @@ long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group
   return pairs;
 }
 
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius) {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    throw Error("neighbour count: expected a radius > 0");
+  }
+  RadiusGrid<size_t> grid(radius);
+  for (size_t i = 0; i < to.points.size(); ++i) grid.Insert(to.points[i].position, i);
+  long with = 0;
+  for (const CloudPoint& p : from.points) {
+    with += grid.AnyNear(p.position, [&](size_t j) {
+      return (to.points[j].position - p.position).norm() <= radius;
+    });
+  }
+  return with;
+}
+
 }  // namespace sapmvs

@@ -19,6 +19,7 @@
 #include "sapmvs/matcher.h"
 #include "sapmvs/raster_io.h"
 #include "sapmvs/surface_check.h"
+#include "truth_check.h"
 
 using namespace sapmvs;
 
@@ -70,16 +71,14 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const Block block = ReadBlock(block_path);
-    const GeoRaster truth = ReadGeoRaster(truth_path);
-    // With the simulator's classes.tif beside the truth: water is not asked
-    // to be covered, and the rows split by class.
-    const std::optional<GeoRaster> classes = ReadClassRasterBeside(truth_path);
+    // With the simulator's classes.tif beside the truth the rows split by class.
+    const Truth truth_data = ReadTruth(truth_path);
+    const GeoRaster& truth = truth_data.surface;
+    const std::optional<GeoRaster>& classes = truth_data.classes;
     const double gsd = EstimateBlockGeometry(block).gsd_median;  // full resolution
-    const double coverage_cell = coverage_cells * base.cell_size * std::ldexp(1.0, level) * gsd;
-    SurfaceCheckOptions so;
-    so.tolerance = gsd;
-    so.cell_size = coverage_cell;
-    if (classes) so.classes = &*classes;
+    const SurfaceCheckOptions so =
+        TruthCheckOptions(truth_data, gsd, level, coverage_cells * base.cell_size);
+    const double coverage_cell = so.cell_size;
     DeviceOptions dev;
     dev.device = device;
     dev.profile = true;

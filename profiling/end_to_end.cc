@@ -28,6 +28,7 @@
 #include "sapmvs/raster_io.h"
 #include "sapmvs/simulate.h"
 #include "sapmvs/surface_check.h"
+#include "truth_check.h"
 
 using namespace sapmvs;
 namespace fs = std::filesystem;
@@ -114,9 +115,7 @@ int main(int argc, char** argv) {
         Simulate(so);
       }
       const Block block = ReadBlock(sim / "block.yaml");
-      const GeoRaster truth = ReadGeoRaster(sim / "truth" / "dsm.tif");
-      const std::optional<GeoRaster> classes =
-          ReadClassRasterBeside((sim / "truth" / "dsm.tif").string());
+      const Truth truth = ReadTruth(sim / "truth" / "dsm.tif");
       const double gsd = EstimateBlockGeometry(block).gsd_median;
       for (const char* mode : {"sapmvs", "pmvs"}) {
         std::cerr << preset << " " << mode << "...\n";
@@ -141,11 +140,7 @@ int main(int argc, char** argv) {
         row.seconds = report.total_seconds;
         for (const auto& [name, k] : report.stats.kernels) row.kernel_seconds += k.seconds;
         row.points = report.points;
-        SurfaceCheckOptions sc;
-        sc.tolerance = gsd;
-        sc.cell_size = 2 * std::ldexp(1.0, level) * gsd;
-        if (classes) sc.classes = &*classes;
-        row.check = CheckAgainstSurface(ReadPly(o.out / "cloud.ply"), truth, block, sc);
+        row.check = CheckAgainstTruth(ReadPly(o.out / "cloud.ply"), truth, block, gsd, level);
         rows.push_back(row);
       }
     }

@@ -26,6 +26,19 @@ PointCloud Grid(double x0, double x1, double y0, double y1, double spacing, doub
   return c;
 }
 
+// `n` points with random scores, uniform in a box of side `side` (a tenth of
+// it high) at (x0, x0), dealt alternately to *a and *b.
+void RandomPair(int n, double side, double x0, PointCloud* a, PointCloud* b) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0, side);
+  for (int i = 0; i < n; ++i) {
+    CloudPoint p;
+    p.position = {x0 + u(rng), x0 + u(rng), 0.1 * u(rng)};
+    p.score = static_cast<float>(u(rng));
+    (i % 2 ? a : b)->points.push_back(p);
+  }
+}
+
 long CrossGroupPairsWithin(const PointCloud& merged, const std::vector<int>& group_of, double r) {
   long pairs = 0;
   for (size_t i = 0; i < merged.points.size(); ++i) {
@@ -132,15 +145,8 @@ TEST(CloudMerge, PointsOfOneGroupAreNeverDroppedForEachOther) {
 }
 
 TEST(CloudMerge, SameInputsGiveTheSameOutput) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(0, 10);
   PointCloud a, b;
-  for (int i = 0; i < 997; ++i) {
-    CloudPoint p;
-    p.position = {u(rng), u(rng), 0.1 * u(rng)};
-    p.score = static_cast<float>(u(rng));
-    (i % 2 ? a : b).points.push_back(p);
-  }
+  RandomPair(997, 10, 0, &a, &b);
   std::vector<GroupCloud> groups = {{&a, {2.0, 5.0}}, {&b, {8.0, 5.0}}};
   MergeOptions o;
   o.radius = 0.3;
@@ -191,6 +197,23 @@ TEST(CloudMerge, CrossGroupPairsCountAsByBruteForce) {
   EXPECT_THROW(CountCrossGroupPairs(c, group_of, 0.0), Error);
   group_of.pop_back();
   EXPECT_THROW(CountCrossGroupPairs(c, group_of, 0.1), Error);
+}
+
+TEST(CloudMerge, NeighbourCountIsAsByBruteForce) {
+  PointCloud a, b;
+  RandomPair(301, 3, 500000.0, &a, &b);
+  for (const double r : {0.03, 0.1, 0.4}) {
+    long expected = 0;
+    for (const CloudPoint& p : a.points) {
+      bool near = false;
+      for (const CloudPoint& q : b.points) near |= (p.position - q.position).norm() <= r;
+      expected += near;
+    }
+    EXPECT_EQ(CountWithNeighbour(a, b, r), expected) << r;
+  }
+  EXPECT_EQ(CountWithNeighbour(a, a, 1e-9), static_cast<long>(a.points.size()));
+  EXPECT_EQ(CountWithNeighbour(a, PointCloud{}, 1.0), 0);
+  EXPECT_THROW(CountWithNeighbour(a, b, 0.0), Error);
 }
 
 }  // namespace

@@ -52,4 +52,9 @@ int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);
 // `radius` of each other (3D): what the merge leaves none of. radius > 0.
 long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of, double radius);
 
+// How many points of `from` have a point of `to` within `radius` (3D): one
+// cloud's coverage of another, as profiling/versus_pmvs2 compares clouds of
+// different matchers. radius > 0.
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius);
+
 }  // namespace sapmvs

@@ -1,0 +1,37 @@
+#pragma once
+// A command run as a child process and measured the way `/usr/bin/time -v`
+// does, through wait4(): so that programs we did not write (PMVS2) and our
+// own are timed alike, each from its own process, threads included.
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sapmvs {
+
+struct ChildCommand {
+  std::vector<std::string> argv;  // argv[0]: a path, or a name looked up on PATH
+  // Set in the child's environment only (e.g. POCL_CPU_MAX_CU_NUM).
+  std::vector<std::pair<std::string, std::string>> env;
+  std::filesystem::path log;  // stdout and stderr go here (truncated); empty = inherited
+
+  // The command as a shell line that repeats it, environment first.
+  std::string ShellLine() const;
+};
+
+struct ChildUsage {
+  int exit_code = -1;  // when it exited
+  int signal = 0;      // when a signal ended it
+  double wall_seconds = 0;
+  double cpu_seconds = 0;   // user + system, all its threads and waited-for children
+  double peak_rss_mib = 0;  // ru_maxrss
+  bool Ok() const { return signal == 0 && exit_code == 0; }
+  // "exit 3" or "signal 9 (Killed)".
+  std::string Describe() const;
+};
+
+// Runs and waits. Throws sapmvs::Error when the process cannot be started or
+// the log not opened; a failing command is reported in the usage, not thrown.
+ChildUsage RunTimed(const ChildCommand& command);
+
+}  // namespace sapmvs

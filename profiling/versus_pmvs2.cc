@@ -1,0 +1,410 @@
+// sapmvs against the real PMVS2 (Furukawa and Ponce's program, the paper's
+// baseline) on the same images, side by side in one run: the block is
+// exported once as a PMVS folder (`sapmvs export --format pmvs`), PMVS2 and
+// `sapmvs run` in each mode match that folder, each as a child process timed
+// through wait4(), and the clouds are compared with each other and, for
+// simulated blocks, with the true surface.
+//
+//   versus_pmvs2 BLOCK [--out DIR] [--level 1] [--threads N] [--truth DSM]
+//                [--modes sapmvs,pmvs] [--max-images N] [--markdown FILE]
+//                [--pmvs2 PATH] [--sapmvs PATH] [--exported PMVS_DIR]
+//
+// PMVS2 is not part of this repository. It is looked for under the build
+// folder (build/anchors/, built by hand there), else $SAPMVS_PMVS2; without
+// it the sapmvs rows still run.
+//
+// Frames: the export writes coordinates in the block's local frame and the
+// offset to world in sapmvs_frame.json. PMVS2's cloud is in that local frame;
+// sapmvs's cloud is in whatever frame its PMVS reader gives the cameras,
+// which is found by comparing a camera it reads with the matrix in txt/.
+// A PMVS folder carries no surface estimate: where sapmvs's reader finds
+// none, `sapmvs run` gets --ground-height: the median height where BLOCK's
+// optical axes meet its surface estimate.
+//
+// Distances: cloud-to-cloud coverage is counted within 1 and 2 GSD of the
+// matched level (the median full-resolution GSD at the scene times
+// 2^level), the spacing both matchers emit points at. Against the truth the
+// numbers are compare_modes' and end_to_end's (truth_check.h).
+#include <unistd.h>
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "sapmvs/block_geometry.h"
+#include "sapmvs/block_reader.h"
+#include "sapmvs/cloud_merge.h"
+#include "sapmvs/error.h"
+#include "sapmvs/ply_io.h"
+#include "timed_child.h"
+#include "truth_check.h"
+
+using namespace sapmvs;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Row {
+  std::string name;  // "PMVS2" or "sapmvs --mode M"
+  ChildUsage usage;
+  PointCloud cloud;                                  // world frame
+  std::optional<double> from_pmvs2[2], to_pmvs2[2];  // at 1 and 2 GSD
+  std::optional<SurfaceCheck> truth;
+};
+
+// The folder of the build that holds this binary (build/profiling/x -> build).
+fs::path BuildDir() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::path() : self.parent_path().parent_path();
+}
+
+bool IsExecutable(const fs::path& p) {
+  return fs::is_regular_file(p) && access(p.c_str(), X_OK) == 0;
+}
+
+// build/anchors/ is where PMVS2 is built by hand (never committed); any
+// executable pmvs2 below it will do.
+fs::path FindPmvs2(const fs::path& build) {
+  const fs::path anchors = build / "anchors";
+  std::error_code ec;
+  if (fs::is_directory(anchors)) {
+    for (auto it = fs::recursive_directory_iterator(anchors, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+      if (it->path().filename() == "pmvs2" && IsExecutable(it->path())) return it->path();
+    }
+  }
+  if (const char* env = std::getenv("SAPMVS_PMVS2"); env && IsExecutable(env)) return env;
+  return {};
+}
+
+std::vector<fs::path> CameraFiles(const fs::path& pmvs) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(pmvs / "txt")) {
+    if (e.path().extension() == ".txt") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+Eigen::Vector3d ReadFrameOrigin(const fs::path& pmvs) {
+  const fs::path file = pmvs / "sapmvs_frame.json";
+  if (!fs::exists(file)) return Eigen::Vector3d::Zero();  // a folder in world coordinates
+  std::ifstream in(file);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.contains("origin") || !j["origin"].is_array() ||
+      j["origin"].size() != 3) {
+    throw InputError(file.string(), 0, "expected {\"origin\": [x, y, z], ...}");
+  }
+  return {j["origin"][0].get<double>(), j["origin"][1].get<double>(), j["origin"][2].get<double>()};
+}
+
+Eigen::Matrix<double, 3, 4> ReadPmvsMatrix(const fs::path& file) {
+  std::ifstream in(file);
+  std::string contour;
+  Eigen::Matrix<double, 3, 4> p;
+  in >> contour;
+  for (int i = 0; i < 12; ++i) in >> p(i / 4, i % 4);
+  if (!in || contour != "CONTOUR") throw InputError(file.string(), 1, "expected CONTOUR and P");
+  return p;
+}
+
+// PMVS2 builds each pyramid level from the one below with a 1-3-3-1 filter
+// sampled at even pixels (Cimage::buildImage), so pixel x of level L shows
+// level 0 at 2^L x + (2^L - 1) / 2, yet it only halves P per level
+// (Ccamera::updateProjection): every image is read (2^L - 1) / 2 pixels off,
+// which biases its heights at L > 0 (+1.2 GSD on the tiny preset at level 1).
+// This writes `dir`, a copy of the folder for PMVS2 whose matrices are
+// shifted by that much (images linked, not copied).
+void WritePyramidShiftedFolder(const fs::path& pmvs, int level, const fs::path& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir / "txt");
+  fs::create_directories(dir / "models");
+  fs::create_directory_symlink(fs::absolute(pmvs / "visualize"), dir / "visualize");
+  fs::copy_file(pmvs / "option", dir / "option");
+  const double shift = 0.5 * (std::ldexp(1.0, level) - 1);
+  for (const fs::path& file : CameraFiles(pmvs)) {
+    Eigen::Matrix<double, 3, 4> p = ReadPmvsMatrix(file);
+    p.row(0) -= shift * p.row(2);
+    p.row(1) -= shift * p.row(2);
+    std::ofstream out(dir / "txt" / file.filename());
+    out << "CONTOUR\n" << std::setprecision(17) << p << "\n";
+    if (!out) throw Error((dir / "txt" / file.filename()).string() + ": write failed");
+  }
+}
+
+// How sapmvs's PMVS reader sees an exported folder.
+struct ReaderFrame {
+  // Added to what it matches to get world coordinates: `origin` when it
+  // keeps the folder's local frame, 0 when it restores the world itself.
+  Eigen::Vector3d to_world = Eigen::Vector3d::Zero();
+  // Whether it finds a surface estimate of its own (PMVS folders carry none).
+  bool has_surface = false;
+};
+
+// The reader's frame is found by comparing its first camera with the matrix
+// in txt/.
+ReaderFrame ReadReaderFrame(const fs::path& pmvs, const Eigen::Vector3d& origin) {
+  const Eigen::Vector3d local =
+      Camera::FromProjectionMatrix(ReadPmvsMatrix(CameraFiles(pmvs).at(0)), 1, 1).center();
+  BlockReadOptions ro;
+  ro.format = BlockFormat::kPmvs;
+  const Block block = ReadBlock(pmvs, ro);
+  const Eigen::Vector3d read = block.images.at(0).camera.center();
+  ReaderFrame f;
+  f.has_surface = EstimateBlockGeometry(block).source != SurfaceSource::kNone;
+  const double tol = 1e-6 * (1 + local.norm() + origin.norm());
+  if ((read - local).norm() <= tol) {
+    f.to_world = origin;
+  } else if ((read - local - origin).norm() > tol) {
+    std::ostringstream s;
+    s << "the PMVS reader puts the first camera at " << read.transpose() << ", the folder at "
+      << local.transpose() << " with origin " << origin.transpose() << ": unknown frame";
+    throw Error(s.str());
+  }
+  return f;
+}
+
+// The median height of the block's scene points (where the optical axes meet
+// its surface estimate).
+double SceneHeight(const BlockGeometry& geometry) {
+  std::vector<double> z;
+  for (const ImageGeometry& g : geometry.images) {
+    if (g.valid) z.push_back(g.scene_point.z());
+  }
+  if (z.empty()) throw Error("no image meets the block's surface estimate");
+  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+  return z[z.size() / 2];
+}
+
+// PMVS2 takes level and CPU from its option file: both are set to the run's,
+// so that the two tools match the same pyramid level with the same threads.
+void SetPmvsOptions(const fs::path& file, int level, int threads) {
+  std::ifstream in(file);
+  if (!in) throw Error(file.string() + ": no PMVS2 option file");
+  std::ostringstream out;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string key;
+    s >> key;
+    if (key == "level") line = "level " + std::to_string(level);
+    if (key == "CPU") line = "CPU " + std::to_string(threads);
+    out << line << "\n";
+  }
+  in.close();
+  std::ofstream(file) << out.str();
+}
+
+void Translate(PointCloud* cloud, const Eigen::Vector3d& by) {
+  for (CloudPoint& p : cloud->points) p.position += by;
+}
+
+// Runs one step; a failing child ends the benchmark, naming its log.
+ChildUsage Step(const ChildCommand& c, std::vector<std::string>* commands) {
+  std::cerr << "+ " << c.ShellLine() << "\n";
+  const ChildUsage u = RunTimed(c);
+  std::ostringstream line;
+  line << c.ShellLine() << "   # " << std::fixed << std::setprecision(1) << u.wall_seconds << " s";
+  commands->push_back(line.str());
+  if (!u.Ok()) {
+    throw Error(c.argv[0] + " failed (" + u.Describe() + "); see " + c.log.string());
+  }
+  return u;
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+std::string Share(const std::optional<double>& v) { return v ? Fixed(100 * *v, 1) + " %" : "–"; }
+
+std::string Table(const std::vector<Row>& rows, bool with_truth) {
+  std::ostringstream t;
+  t << "| tool / mode | wall s | CPU s | CPU/wall | peak RSS MiB | points "
+       "| PMVS2→ours 1 GSD | PMVS2→ours 2 GSD | ours→PMVS2 1 GSD | ours→PMVS2 2 GSD |";
+  if (with_truth) t << " within 1 GSD | median \\|dz\\| | coverage |";
+  t << "\n|---|---|---|---|---|---|---|---|---|---|" << (with_truth ? "---|---|---|" : "") << "\n";
+  for (const Row& r : rows) {
+    const ChildUsage& u = r.usage;
+    t << "| " << r.name << " | " << Fixed(u.wall_seconds, 1) << " | " << Fixed(u.cpu_seconds, 1)
+      << " | " << Fixed(u.cpu_seconds / std::max(u.wall_seconds, 1e-9), 2) << " | "
+      << Fixed(u.peak_rss_mib, 0) << " | " << r.cloud.points.size() << " | "
+      << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1]) << " | " << Share(r.to_pmvs2[0])
+      << " | " << Share(r.to_pmvs2[1]) << " |";
+    if (with_truth) {
+      if (r.truth) {
+        t << " " << Fixed(100 * r.truth->share_within, 1) << " % | "
+          << Fixed(r.truth->median_abs_dz, 3) << " | " << Fixed(100 * r.truth->coverage, 1)
+          << " % |";
+      } else {
+        t << " – | – | – |";
+      }
+    }
+    t << "\n";
+  }
+  return t.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("sapmvs against PMVS2 on the same exported images, in one run");
+  std::string block_path, out_dir = "/tmp/versus_pmvs2", truth_path, markdown_path;
+  std::string pmvs2_path, sapmvs_path, exported_dir;
+  int level = 1, max_images = 0;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::string> modes = {"sapmvs", "pmvs"};
+  app.add_option("block", block_path, "Block file or folder (any format sapmvs reads)")->required();
+  app.add_option("--out", out_dir, "Work folder: pmvs/, run_<mode>/, logs/")->capture_default_str();
+  app.add_option("--level", level, "Pyramid level for both tools")->capture_default_str();
+  app.add_option("--threads", threads, "Threads for both: PMVS2's CPU, PoCL's POCL_CPU_MAX_CU_NUM")
+      ->capture_default_str();
+  app.add_option("--truth", truth_path, "True surface raster (a simulated block's truth/dsm.tif)");
+  app.add_option("--modes", modes, "sapmvs run modes")->delimiter(',')->capture_default_str();
+  app.add_option("--max-images", max_images,
+                 "sapmvs run --max-images (default: all images, one group, as PMVS2)");
+  app.add_option("--markdown", markdown_path, "Append the table and commands to this file");
+  app.add_option("--pmvs2", pmvs2_path,
+                 "PMVS2 binary (default: build/anchors/**/pmvs2, else $SAPMVS_PMVS2)");
+  app.add_option("--sapmvs", sapmvs_path, "sapmvs binary (default: build/sapmvs)");
+  app.add_option("--exported", exported_dir,
+                 "Use this PMVS folder of BLOCK instead of exporting one (its option "
+                 "file gets --level and --threads; PMVS2 writes its models/)");
+  bool shift_pyramid = false;
+  app.add_flag("--shift-pmvs2-pyramid", shift_pyramid,
+               "Give PMVS2 matrices shifted by (2^level - 1)/2 px, undoing its pyramid's offset "
+               "(OUT/pmvs2_shifted)");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (level < 0 || threads < 1 || max_images < 0) {
+      throw Error("expected --level >= 0, --threads >= 1, --max-images >= 0");
+    }
+    const fs::path build = BuildDir();
+    const fs::path sapmvs = sapmvs_path.empty() ? build / "sapmvs" : fs::path(sapmvs_path);
+    if (!IsExecutable(sapmvs)) throw Error(sapmvs.string() + ": no sapmvs binary (--sapmvs)");
+    const fs::path pmvs2 = pmvs2_path.empty() ? FindPmvs2(build) : fs::path(pmvs2_path);
+    if (!pmvs2_path.empty() && !IsExecutable(pmvs2)) {
+      throw Error(pmvs2_path + ": not an executable (--pmvs2)");
+    }
+    const fs::path out = out_dir, logs = out / "logs";
+    fs::create_directories(logs);
+    std::vector<std::string> commands;
+    const std::string level_arg = std::to_string(level);
+
+    const fs::path pmvs = exported_dir.empty() ? out / "pmvs" : fs::path(exported_dir);
+    if (exported_dir.empty()) {
+      fs::remove_all(pmvs);
+      Step({{sapmvs.string(), "export", block_path, "--format", "pmvs", "--out", pmvs.string(),
+             "--level", level_arg},
+            {},
+            logs / "export.log"},
+           &commands);
+    }
+    const Eigen::Vector3d origin = ReadFrameOrigin(pmvs);
+    const int images = static_cast<int>(CameraFiles(pmvs).size());
+    const Block block = ReadBlock(block_path);
+    if (images != static_cast<int>(block.images.size())) {
+      throw Error(pmvs.string() + ": " + std::to_string(images) + " cameras, the block has " +
+                  std::to_string(block.images.size()));
+    }
+    const BlockGeometry geometry = EstimateBlockGeometry(block);
+    const double gsd = geometry.gsd_median;
+    if (!(gsd > 0)) throw Error(block_path + ": no GSD estimate (no surface for the cameras)");
+    const double gsd_level = std::ldexp(gsd, level);
+
+    std::vector<Row> rows;
+    if (pmvs2.empty()) {
+      std::cout << "PMVS2 not built: skipped\n";
+    } else {
+      SetPmvsOptions(pmvs / "option", level, threads);
+      fs::path input = pmvs;
+      if (shift_pyramid) {
+        input = out / "pmvs2_shifted";
+        WritePyramidShiftedFolder(pmvs, level, input);
+      }
+      fs::create_directories(input / "models");
+      fs::remove(input / "models" / "option.ply");
+      Row r;
+      r.name = shift_pyramid ? "PMVS2, P shifted for its pyramid" : "PMVS2";
+      // PMVS2 joins the prefix and its file names as strings.
+      r.usage = Step({{pmvs2.string(), input.string() + "/", "option"}, {}, logs / "pmvs2.log"},
+                     &commands);
+      r.cloud = ReadPly(input / "models" / "option.ply");
+      Translate(&r.cloud, origin);
+      rows.push_back(std::move(r));
+    }
+    const ReaderFrame frame = ReadReaderFrame(pmvs, origin);
+    // A PMVS folder has no surface estimate; sapmvs gets the one it would
+    // take from BLOCK (PMVS2 needs none: it searches all depths).
+    std::vector<std::string> surface_args;
+    if (!frame.has_surface) {
+      surface_args = {"--ground-height", Fixed(SceneHeight(geometry) - frame.to_world.z(), 3)};
+    }
+    for (const std::string& mode : modes) {
+      const fs::path run = out / ("run_" + mode);
+      Row r;
+      r.name = "sapmvs --mode " + mode;
+      ChildCommand c{{sapmvs.string(), "run", pmvs.string(), "--out", run.string(), "--level",
+                      level_arg, "--max-images", std::to_string(max_images ? max_images : images),
+                      "--mode", mode, "--restart", "-q"},
+                     {{"POCL_CPU_MAX_CU_NUM", std::to_string(threads)}},
+                     logs / ("run_" + mode + ".log")};
+      c.argv.insert(c.argv.end(), surface_args.begin(), surface_args.end());
+      r.usage = Step(c, &commands);
+      r.cloud = ReadPly(run / "cloud.ply");
+      Translate(&r.cloud, frame.to_world);
+      rows.push_back(std::move(r));
+    }
+
+    const bool have_pmvs2 = !pmvs2.empty();
+    std::optional<Truth> truth;
+    if (!truth_path.empty()) truth = ReadTruth(truth_path);
+    for (Row& r : rows) {
+      if (have_pmvs2 && &r != &rows.front()) {
+        const PointCloud& theirs = rows.front().cloud;
+        for (int k = 0; k < 2; ++k) {
+          const double radius = (k + 1) * gsd_level;
+          if (!theirs.points.empty()) {
+            r.from_pmvs2[k] = static_cast<double>(CountWithNeighbour(theirs, r.cloud, radius)) /
+                              theirs.points.size();
+          }
+          if (!r.cloud.points.empty()) {
+            r.to_pmvs2[k] = static_cast<double>(CountWithNeighbour(r.cloud, theirs, radius)) /
+                            r.cloud.points.size();
+          }
+        }
+      }
+      if (truth) r.truth = CheckAgainstTruth(r.cloud, *truth, block, gsd, level);
+    }
+
+    std::ostringstream md;
+    md << "### " << block_path << ", level " << level << ", " << images << " images, " << threads
+       << " threads\n\n"
+       << "GSD " << Fixed(gsd, 4) << " at full resolution, " << Fixed(gsd_level, 4) << " at level "
+       << level << " (the cloud-to-cloud distances)";
+    if (truth) md << "; truth " << truth_path << " (within 1 full-resolution GSD)";
+    md << ".\n\n" << Table(rows, truth.has_value()) << "\n";
+    if (!have_pmvs2) md << "PMVS2 not built: skipped.\n\n";
+    md << "Commands (cwd " << fs::current_path().string() << "):\n\n```sh\n";
+    for (const std::string& c : commands) md << c << "\n";
+    md << "```\n\n";
+    std::cout << md.str();
+    if (!markdown_path.empty()) {
+      std::ofstream f(markdown_path, std::ios::app);
+      f << md.str();
+      if (!f) throw Error(markdown_path + ": write failed");
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "versus_pmvs2: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
