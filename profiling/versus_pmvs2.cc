@@ -17,9 +17,10 @@
 // offset to world in sapmvs_frame.json. PMVS2's cloud is in that local frame;
 // sapmvs's cloud is in whatever frame its PMVS reader gives the cameras,
 // which is found by comparing a camera it reads with the matrix in txt/.
-// A PMVS folder carries no surface estimate: where sapmvs's reader finds
-// none, `sapmvs run` gets --ground-height: the median height where BLOCK's
-// optical axes meet its surface estimate.
+// Same inputs: sapmvs matches the exported folder with its images and
+// cameras only, as PMVS2 does; the surface prior an export records (the
+// block's DEM or ground height) is taken out of sapmvs_frame.json, so sapmvs
+// finds its depths from tie points, as PMVS2 from its own seeds.
 //
 // Distances: cloud-to-cloud coverage is counted within 1 and 2 GSD of the
 // matched level (the median full-resolution GSD at the scene times
@@ -144,8 +145,6 @@ struct ReaderFrame {
   // Added to what it matches to get world coordinates: `origin` when it
   // keeps the folder's local frame, 0 when it restores the world itself.
   Eigen::Vector3d to_world = Eigen::Vector3d::Zero();
-  // Whether it finds a surface estimate of its own (PMVS folders carry none).
-  bool has_surface = false;
 };
 
 // The reader's frame is found by comparing its first camera with the matrix
@@ -158,7 +157,6 @@ ReaderFrame ReadReaderFrame(const fs::path& pmvs, const Eigen::Vector3d& origin)
   const Block block = ReadBlock(pmvs, ro);
   const Eigen::Vector3d read = block.images.at(0).camera.center();
   ReaderFrame f;
-  f.has_surface = EstimateBlockGeometry(block).source != SurfaceSource::kNone;
   const double tol = 1e-6 * (1 + local.norm() + origin.norm());
   if ((read - local).norm() <= tol) {
     f.to_world = origin;
@@ -171,16 +169,19 @@ ReaderFrame ReadReaderFrame(const fs::path& pmvs, const Eigen::Vector3d& origin)
   return f;
 }
 
-// The median height of the block's scene points (where the optical axes meet
-// its surface estimate).
-double SceneHeight(const BlockGeometry& geometry) {
-  std::vector<double> z;
-  for (const ImageGeometry& g : geometry.images) {
-    if (g.valid) z.push_back(g.scene_point.z());
-  }
-  if (z.empty()) throw Error("no image meets the block's surface estimate");
-  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-  return z[z.size() / 2];
+// Takes the surface prior out of an exported folder's side file (see the
+// top of this file).
+void StripSurfacePrior(const fs::path& pmvs) {
+  const fs::path side = pmvs / "sapmvs_frame.json";
+  std::ifstream in(side);
+  if (!in) throw Error(side.string() + ": cannot read");
+  nlohmann::json j = nlohmann::json::parse(in);
+  in.close();
+  j.erase("dem");
+  j.erase("ground_height");
+  std::ofstream out(side);
+  out << j.dump(2) << "\n";
+  if (!out) throw Error(side.string() + ": cannot write");
 }
 
 // PMVS2 takes level and CPU from its option file: both are set to the run's,
@@ -308,6 +309,7 @@ int main(int argc, char** argv) {
             logs / "export.log"},
            &commands);
     }
+    StripSurfacePrior(pmvs);
     const Eigen::Vector3d origin = ReadFrameOrigin(pmvs);
     const int images = static_cast<int>(CameraFiles(pmvs).size());
     const Block block = ReadBlock(block_path);
@@ -342,12 +344,6 @@ int main(int argc, char** argv) {
       rows.push_back(std::move(r));
     }
     const ReaderFrame frame = ReadReaderFrame(pmvs, origin);
-    // A PMVS folder has no surface estimate; sapmvs gets the one it would
-    // take from BLOCK (PMVS2 needs none: it searches all depths).
-    std::vector<std::string> surface_args;
-    if (!frame.has_surface) {
-      surface_args = {"--ground-height", Fixed(SceneHeight(geometry) - frame.to_world.z(), 3)};
-    }
     for (const std::string& mode : modes) {
       const fs::path run = out / ("run_" + mode);
       Row r;
@@ -357,7 +353,6 @@ int main(int argc, char** argv) {
                       "--mode", mode, "--restart", "-q"},
                      {{"POCL_CPU_MAX_CU_NUM", std::to_string(threads)}},
                      logs / ("run_" + mode + ".log")};
-      c.argv.insert(c.argv.end(), surface_args.begin(), surface_args.end());
       r.usage = Step(c, &commands);
       r.cloud = ReadPly(run / "cloud.ply");
       Translate(&r.cloud, frame.to_world);
