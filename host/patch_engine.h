@@ -6,7 +6,9 @@
 // threshold, and accept the patch when they are at least min_image_num - 1.
 // In sapmvs mode an accepted patch is then scored at the adaptive sizes,
 // largest first (21, 15, 11, 7), each size one launch for the whole batch,
-// and takes the largest size at which it still passes. Each size first
+// and takes the largest size at which it still passes; only a patch with a
+// view at least 2 max_angle_deg from its reference is tried at the larger
+// sizes (narrow views do not pin a large plane down). Each size first
 // polishes the patch at that size (a short refinement, one launch per size):
 // the 7 x 7 window constrains the normal too loosely to extrapolate it over
 // 21 pixels. Only patches whose unpolished plane already reaches
@@ -90,8 +92,10 @@ class PatchEngine {
   double SigmaColor() const;
   bool OnParentPlane(const PatchCandidate& candidate, const Eigen::Vector3d& center) const;
   // True when some pair of the reference and `views` meets at x at an angle
-  // in (max_angle_deg, view_angle_deg).
-  bool WideEnough(const Eigen::Vector3d& x, int ref, const std::vector<int>& views) const;
+  // in (max_angle_deg, view_angle_deg); with from_ref, some pair of the
+  // reference and a view at an angle in (2 max_angle_deg, view_angle_deg).
+  bool WideEnough(const Eigen::Vector3d& x, int ref, const std::vector<int>& views,
+                  bool from_ref = false) const;
   std::vector<int> VisibleViews(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
                                 int ref, int half) const;
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,

@@ -70,6 +70,9 @@ TEST_F(PatchEngineTest, FlatGroundGrowsToTheLargestSizeFromATiltedStart) {
   const MatchGroupData group = GroupOf(scene);
   MatcherOptions options;  // sapmvs mode, sizes 21, 15, 11, 7
   ASSERT_EQ(options.adaptive_sizes.front(), 21);
+  // The scene's cameras are a few metres apart at 40 m: growth needs a view
+  // 2 max_angle from the reference (WorthPolishing), so 5 degrees here.
+  options.max_angle_deg = 5.0;
   PatchEngine engine(context(), group, options);
   const std::vector<PatchCandidate> seeds = TiltedSeeds(scene, 12, 1.0, 6.0, 92);
   const auto results = engine.Evaluate(seeds);
@@ -151,6 +154,22 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
       EXPECT_LT(std::abs(ref.Depth(r->center) - ref.Depth(truth)) / Footprint(ref, truth), 0.5);
     }
     EXPECT_EQ(accepted, 8);
+  }
+  // sapmvs mode: the views of image 0 are 4 and 8 degrees from it, under 2
+  // max_angle, so its patches stay at window_size; with max_angle 3 they
+  // grow.
+  for (const double max_angle : {10.0, 3.0}) {
+    MatcherOptions sapmvs;
+    sapmvs.max_angle_deg = max_angle;
+    PatchEngine engine(context(), group, sapmvs);
+    int grown = 0, accepted = 0;
+    for (const auto& r : engine.Evaluate(TiltedSeeds(strip, 8, 0.0, 0.0, 98))) {
+      accepted += r.has_value();
+      grown += r && r->size > sapmvs.window_size;
+    }
+    EXPECT_EQ(accepted, 8) << "max_angle " << max_angle;
+    if (max_angle > 4) EXPECT_EQ(grown, 0);
+    if (max_angle < 4) EXPECT_GE(grown, 6);
   }
   const PlaneScene narrow = MakePlaneScene(5, 201, 161, 96, 40.0 * std::tan(0.5 * kPiRad / 180.0));
   const MatchGroupData narrow_group = GroupOf(narrow);
