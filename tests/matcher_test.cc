@@ -1,7 +1,6 @@
 #include "sapmvs/matcher.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +15,6 @@
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/raster_io.h"
-#include "sapmvs/simulate.h"
 #include "sapmvs/surface_check.h"
 #include "test_util.h"
 
@@ -148,27 +146,8 @@ class MatchGroupTest : public test::ClTest {
 
  protected:
   // The tiny preset, simulated once per test process (in-process, ~6 s).
-  static const fs::path& TinyDir() {
-    static const fs::path dir = [] {
-      const fs::path d = fs::temp_directory_path() /
-                         ("sapmvs_matcher_test_" + std::to_string(::getpid()) + "_tiny");
-      fs::remove_all(d);
-      SimulateOptions o;
-      o.preset = "tiny";
-      o.out = d;
-      o.seed = 1;
-      o.quiet = true;
-      Simulate(o);
-      return d;
-    }();
-    return dir;
-  }
-  static void TearDownTestSuite() {
-    std::error_code ec;
-    fs::remove_all(
-        fs::temp_directory_path() / ("sapmvs_matcher_test_" + std::to_string(::getpid()) + "_tiny"),
-        ec);
-  }
+  static fs::path TinyDir() { return test::Simulated("matcher_test_tiny", "tiny", 1); }
+  static void TearDownTestSuite() { test::RemoveSimulated("matcher_test_tiny"); }
 
   static MatcherOptions Options(MatchMode mode) {
     MatcherOptions o;

@@ -1,6 +1,7 @@
 #include "test_util.h"
 
 #include "sapmvs/error.h"
+#include "sapmvs/simulate.h"
 
 #include <unistd.h>
 #include <Eigen/Dense>
@@ -17,6 +18,34 @@
 namespace sapmvs::test {
 
 std::filesystem::path TestDir() { return SAPMVS_TEST_DIR; }
+
+namespace {
+std::filesystem::path SimulatedPath(const std::string& tag) {
+  return std::filesystem::temp_directory_path() /
+         ("sapmvs_" + tag + "_" + std::to_string(::getpid()));
+}
+}  // namespace
+
+std::filesystem::path Simulated(const std::string& tag, const std::string& preset, int seed) {
+  static std::map<std::string, std::filesystem::path> made;
+  auto it = made.find(tag);
+  if (it != made.end() && std::filesystem::exists(it->second)) return it->second;
+  const std::filesystem::path d = SimulatedPath(tag);
+  std::filesystem::remove_all(d);
+  SimulateOptions o;
+  o.preset = preset;
+  o.out = d;
+  o.seed = seed;
+  o.quiet = true;
+  Simulate(o);
+  made[tag] = d;
+  return d;
+}
+
+void RemoveSimulated(const std::string& tag) {
+  std::error_code ec;
+  std::filesystem::remove_all(SimulatedPath(tag), ec);
+}
 
 std::filesystem::path SharedDir() {
   if (const char* env = std::getenv("SAPMVS_SHARED_DIR"); env && *env) return env;

@@ -22,6 +22,12 @@ std::filesystem::path SharedDir();
 // A fresh, empty directory under the system temp dir, unique per test.
 std::filesystem::path ScratchDir();
 
+// The simulator's `preset` rendered with `seed` into a temp folder named for
+// `tag` and this process, once per process (tiny takes seconds); the caller
+// removes it (RemoveSimulated) when its tests are done.
+std::filesystem::path Simulated(const std::string& tag, const std::string& preset, int seed);
+void RemoveSimulated(const std::string& tag);
+
 // Kernel-versus-reference comparison: |actual - expected| <= abs_tol + rel_tol
 // * |expected|, and NaN exactly where the reference has NaN (border policies
 // must agree bit for bit).

@@ -1,7 +1,6 @@
 #include "sapmvs/tie_points.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +9,6 @@
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/raster_io.h"
-#include "sapmvs/simulate.h"
 #include "test_util.h"
 
 namespace sapmvs {
@@ -19,28 +17,11 @@ namespace {
 namespace fs = std::filesystem;
 
 // The tiny preset, simulated once per test process.
-const fs::path& TinyDir() {
-  static const fs::path dir = [] {
-    const fs::path d =
-        fs::temp_directory_path() / ("sapmvs_tie_points_test_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    SimulateOptions o;
-    o.preset = "tiny";
-    o.out = d;
-    o.seed = 3;
-    o.quiet = true;
-    Simulate(o);
-    return d;
-  }();
-  return dir;
-}
+fs::path TinyDir() { return test::Simulated("tie_points_test_tiny", "tiny", 3); }
 
 class TiePointsTest : public ::testing::Test {
  protected:
-  static void TearDownTestSuite() {
-    std::error_code ec;
-    fs::remove_all(TinyDir(), ec);
-  }
+  static void TearDownTestSuite() { test::RemoveSimulated("tie_points_test_tiny"); }
   // The simulated block as a user without a surface prior brings it.
   static Block NoPrior() {
     Block b = ReadBlock(TinyDir() / "block.yaml");
