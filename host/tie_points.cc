@@ -31,17 +31,13 @@ struct ImageFeatures {
 ImageFeatures Detect(const BlockImage& image, const Eigen::Vector3d& origin,
                      const TiePointOptions& o) {
   ImageFeatures out;
-  LoadedImage loaded = LoadUndistorted(image);
-  cv::Mat bgr = loaded.pixels;
+  const LoadedImage loaded = LoadUndistorted(image);
+  int level = 0;
   Camera camera = loaded.camera;
-  // Halving with 2x2 area averaging keeps pixel centres where
-  // Intrinsics::Scaled puts them (as LoadMatchGroup does).
   while (std::max(camera.width(), camera.height()) > o.max_side) {
-    camera = camera.Scaled(0.5);
-    cv::Mat half;
-    cv::resize(bgr, half, cv::Size(camera.width(), camera.height()), 0, 0, cv::INTER_AREA);
-    bgr = half;
+    camera = loaded.camera.Scaled(std::ldexp(1.0, -++level));
   }
+  const cv::Mat bgr = ResampleToLevel(loaded.pixels, level, camera.width(), camera.height());
   out.camera = camera.Translated(origin);
   cv::Mat grey;
   cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
