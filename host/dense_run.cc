@@ -25,15 +25,19 @@
 
 namespace sapmvs {
 
+GroupingOptions RunOptions::Grouping() const {
+  GroupingOptions g = grouping;
+  g.level = matcher.level;
+  g.min_image_num = matcher.min_image_num;
+  return g;
+}
+
 std::string RunOptions::Problem() const {
   if (block.empty()) return "a block path";
   if (out.empty()) return "an output folder (--out)";
   std::string p = matcher.Problem();
   if (!p.empty()) return p;
-  GroupingOptions g = grouping;
-  g.level = matcher.level;
-  g.min_image_num = matcher.min_image_num;
-  p = g.Problem();
+  p = Grouping().Problem();
   if (!p.empty()) return p;
   if (max_groups < 0) return "max_groups >= 0 (max_groups = " + std::to_string(max_groups) + ")";
   if (!(std::isfinite(merge_radius_gsd) && merge_radius_gsd > 0)) {
@@ -147,9 +151,7 @@ RunReport RunDense(const RunOptions& options) {
   const Block block = ReadBlock(options.block, options.read);
   report.images = static_cast<int>(block.images.size());
   const BlockGeometry geometry = EstimateBlockGeometry(block);
-  GroupingOptions gopt = options.grouping;
-  gopt.level = options.matcher.level;
-  gopt.min_image_num = options.matcher.min_image_num;
+  const GroupingOptions gopt = options.Grouping();
   GroupingPlan plan;
   ImageGroup all;
   all.images.resize(block.images.size());

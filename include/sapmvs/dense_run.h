@@ -32,7 +32,7 @@ struct RunOptions {
   // OpenCL device: index or name substring ("" = SAPMVS_DEVICE, else the default).
   std::string device;
   MatcherOptions matcher;
-  // Its level is taken from matcher.level.
+  // Its level and min_image_num are taken from the matcher's (Grouping()).
   GroupingOptions grouping;
   // Discard DIR/groups/ and start over instead of resuming.
   bool restart = false;
@@ -47,6 +47,8 @@ struct RunOptions {
   // times in the report, and the profile tables (run_profile.h).
   bool profile = false;
 
+  // `grouping` with the matcher's level and min_image_num, as the plan uses it.
+  GroupingOptions Grouping() const;
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
   bool Check() const;
