@@ -14,9 +14,9 @@
 // it the sapmvs rows still run.
 //
 // Frames: the export writes coordinates in the block's local frame and the
-// offset to world in sapmvs_frame.json. PMVS2's cloud is in that local frame;
-// sapmvs's cloud is in whatever frame its PMVS reader gives the cameras,
-// which is found by comparing a camera it reads with the matrix in txt/.
+// offset to world in sapmvs_frame.json. PMVS2's cloud is in that local frame
+// and is moved by the offset; sapmvs's PMVS reader applies the side file, so
+// its cloud is in the world frame already.
 // Same inputs: sapmvs matches the exported folder with its images and
 // cameras only, as PMVS2 does; the surface prior an export records (the
 // block's DEM or ground height) is taken out of sapmvs_frame.json, so sapmvs
@@ -33,7 +33,6 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -42,6 +41,7 @@
 #include "sapmvs/block_reader.h"
 #include "sapmvs/cloud_merge.h"
 #include "sapmvs/error.h"
+#include "sapmvs/export_frame.h"
 #include "sapmvs/ply_io.h"
 #include "timed_child.h"
 #include "truth_check.h"
@@ -94,18 +94,6 @@ std::vector<fs::path> CameraFiles(const fs::path& pmvs) {
   return files;
 }
 
-Eigen::Vector3d ReadFrameOrigin(const fs::path& pmvs) {
-  const fs::path file = pmvs / "sapmvs_frame.json";
-  if (!fs::exists(file)) return Eigen::Vector3d::Zero();  // a folder in world coordinates
-  std::ifstream in(file);
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.contains("origin") || !j["origin"].is_array() ||
-      j["origin"].size() != 3) {
-    throw InputError(file.string(), 0, "expected {\"origin\": [x, y, z], ...}");
-  }
-  return {j["origin"][0].get<double>(), j["origin"][1].get<double>(), j["origin"][2].get<double>()};
-}
-
 Eigen::Matrix<double, 3, 4> ReadPmvsMatrix(const fs::path& file) {
   std::ifstream in(file);
   std::string contour;
@@ -140,48 +128,17 @@ void WritePyramidShiftedFolder(const fs::path& pmvs, int level, const fs::path& 
   }
 }
 
-// How sapmvs's PMVS reader sees an exported folder.
-struct ReaderFrame {
-  // Added to what it matches to get world coordinates: `origin` when it
-  // keeps the folder's local frame, 0 when it restores the world itself.
-  Eigen::Vector3d to_world = Eigen::Vector3d::Zero();
-};
-
-// The reader's frame is found by comparing its first camera with the matrix
-// in txt/.
-ReaderFrame ReadReaderFrame(const fs::path& pmvs, const Eigen::Vector3d& origin) {
-  const Eigen::Vector3d local =
-      Camera::FromProjectionMatrix(ReadPmvsMatrix(CameraFiles(pmvs).at(0)), 1, 1).center();
-  BlockReadOptions ro;
-  ro.format = BlockFormat::kPmvs;
-  const Block block = ReadBlock(pmvs, ro);
-  const Eigen::Vector3d read = block.images.at(0).camera.center();
-  ReaderFrame f;
-  const double tol = 1e-6 * (1 + local.norm() + origin.norm());
-  if ((read - local).norm() <= tol) {
-    f.to_world = origin;
-  } else if ((read - local - origin).norm() > tol) {
-    std::ostringstream s;
-    s << "the PMVS reader puts the first camera at " << read.transpose() << ", the folder at "
-      << local.transpose() << " with origin " << origin.transpose() << ": unknown frame";
-    throw Error(s.str());
-  }
-  return f;
-}
-
 // Takes the surface prior out of an exported folder's side file (see the
 // top of this file).
-void StripSurfacePrior(const fs::path& pmvs) {
-  const fs::path side = pmvs / "sapmvs_frame.json";
-  std::ifstream in(side);
-  if (!in) throw Error(side.string() + ": cannot read");
-  nlohmann::json j = nlohmann::json::parse(in);
-  in.close();
-  j.erase("dem");
-  j.erase("ground_height");
-  std::ofstream out(side);
-  out << j.dump(2) << "\n";
-  if (!out) throw Error(side.string() + ": cannot write");
+// Returns the folder's offset to world (zero for a folder without a side
+// file, already in world coordinates).
+Eigen::Vector3d StripSurfacePrior(const fs::path& pmvs) {
+  std::optional<ExportFrame> frame = ReadExportFrame(pmvs);
+  if (!frame) return Eigen::Vector3d::Zero();
+  frame->ground_height.reset();
+  frame->dem.clear();
+  WriteExportFrame(pmvs, *frame);
+  return frame->origin;
 }
 
 // PMVS2 takes level and CPU from its option file: both are set to the run's,
@@ -309,8 +266,7 @@ int main(int argc, char** argv) {
             logs / "export.log"},
            &commands);
     }
-    StripSurfacePrior(pmvs);
-    const Eigen::Vector3d origin = ReadFrameOrigin(pmvs);
+    const Eigen::Vector3d origin = StripSurfacePrior(pmvs);
     const int images = static_cast<int>(CameraFiles(pmvs).size());
     const Block block = ReadBlock(block_path);
     if (images != static_cast<int>(block.images.size())) {
@@ -343,7 +299,6 @@ int main(int argc, char** argv) {
       Translate(&r.cloud, origin);
       rows.push_back(std::move(r));
     }
-    const ReaderFrame frame = ReadReaderFrame(pmvs, origin);
     for (const std::string& mode : modes) {
       const fs::path run = out / ("run_" + mode);
       Row r;
@@ -355,7 +310,6 @@ int main(int argc, char** argv) {
                      logs / ("run_" + mode + ".log")};
       r.usage = Step(c, &commands);
       r.cloud = ReadPly(run / "cloud.ply");
-      Translate(&r.cloud, frame.to_world);
       rows.push_back(std::move(r));
     }
 
