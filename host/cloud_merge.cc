@@ -193,17 +193,22 @@ long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group
   return pairs;
 }
 
-long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius) {
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
+                        std::vector<bool>* has) {
   if (!(std::isfinite(radius) && radius > 0)) {
     throw Error("neighbour count: expected a radius > 0");
   }
   RadiusGrid<size_t> grid(radius);
   for (size_t i = 0; i < to.points.size(); ++i) grid.Insert(to.points[i].position, i);
   long with = 0;
-  for (const CloudPoint& p : from.points) {
-    with += grid.AnyNear(p.position, [&](size_t j) {
+  if (has) has->assign(from.points.size(), false);
+  for (size_t i = 0; i < from.points.size(); ++i) {
+    const CloudPoint& p = from.points[i];
+    const bool near = grid.AnyNear(p.position, [&](size_t j) {
       return (to.points[j].position - p.position).norm() <= radius;
     });
+    with += near;
+    if (has) (*has)[i] = near;
   }
   return with;
 }

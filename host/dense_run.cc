@@ -19,6 +19,7 @@
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/las_io.h"
+#include "sapmvs/memory_use.h"
 #include "sapmvs/ply_io.h"
 #include "sapmvs/progress.h"
 #include "sapmvs/raster_io.h"
@@ -65,12 +66,6 @@ namespace {
 
 double Since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-double PeakRssBytes() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return 1024.0 * static_cast<double>(u.ru_maxrss);  // Linux reports kilobytes
 }
 
 void AddStats(const MatchStats& s, MatchStats* sum) {
@@ -309,6 +304,8 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
     out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t.wall
         << " s wall";
     if (t.device > 0) out << ", " << t.device << " s in kernels";
+    if (t.peak_rss_bytes > 0)
+      out << ", peak " << std::lround(t.peak_rss_bytes / (1 << 20)) << " MiB";
     out << "\n";
   }
   for (const auto& [name, t] : report.stages) {

@@ -16,6 +16,7 @@
 #include "propagation.h"
 #include "sapmvs/error.h"
 #include "sapmvs/kernel_limits.h"
+#include "sapmvs/memory_use.h"
 #include "sapmvs/progress.h"
 #include "seed_matcher.h"
 
@@ -132,6 +133,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     t.wall = Seconds(stage_start);
     const double device_now = engine_ptr ? DeviceSeconds(*engine_ptr) : 0;
     t.device = device_now - device_before;
+    t.peak_rss_bytes = PeakRssBytes();
     device_before = device_now;
     // Stages repeated by the expand-filter passes add up under one name.
     auto same = std::find_if(stats.stages.begin(), stats.stages.end(),
@@ -141,6 +143,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     } else {
       same->second.wall += t.wall;
       same->second.device += t.device;
+      same->second.peak_rss_bytes = t.peak_rss_bytes;
     }
     stage_start = std::chrono::steady_clock::now();
   };

@@ -76,9 +76,12 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(PatchRefiner& refiner,
   ClEvent event;
   std::vector<RefinedPatch> out = refiner.Refine(patches, views, &event);
   const int size = refiner.options().patch_size;
+  // Rounds run: each either moved or halved, up to the halving limit.
+  const PatchRefinerOptions& ro = refiner.options();
   double evaluations = 0;
-  for (const auto& v : views) {
-    evaluations += static_cast<double>(v.size()) * (1 + 6 * refiner.options().iterations);
+  for (size_t i = 0; i < views.size(); ++i) {
+    const int rounds = std::min(ro.iterations, out[i].moves + ro.max_halvings);
+    evaluations += static_cast<double>(views[i].size()) * (1 + 6 * rounds);
   }
   Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size), size,
         static_cast<long>(patches.size()), evaluations, event);

@@ -31,6 +31,9 @@ std::string OptionsProblem(const PatchRefinerOptions& o) {
     return "iterations 0 to " + std::to_string(kMaxRefineIterations) +
            " (iterations = " + std::to_string(o.iterations) + ")";
   }
+  if (o.max_halvings < 1) {
+    return "max_halvings >= 1 (max_halvings = " + std::to_string(o.max_halvings) + ")";
+  }
   if (!(std::isfinite(o.depth_step) && o.depth_step > 0.0)) {
     return "depth_step finite and > 0 (depth_step = " + std::to_string(o.depth_step) + ")";
   }
@@ -174,7 +177,8 @@ std::vector<RefinedPatch> PatchRefiner::Refine(const std::vector<NccPatch>& patc
 
   kernel_.SetArgs(group_->images, group_->image_table, group_->cameras, cl_int{group_->num_images},
                   patch_buffer, static_cast<cl_int>(patches.size()), offset_buffer, index_buffer,
-                  cl_int{options_.iterations}, static_cast<cl_float>(options_.depth_step),
+                  cl_int{options_.iterations}, cl_int{options_.max_halvings},
+                  static_cast<cl_float>(options_.depth_step),
                   static_cast<cl_float>(Radians(options_.angle_step_deg)),
                   static_cast<cl_float>(Radians(options_.max_angle_deg)), result_buffer,
                   score_buffer);
@@ -254,7 +258,8 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
     double score = evaluate(p, &r.view_scores);
     double margin = inf;
     std::vector<double> trial;
-    for (int it = 0; it < options.iterations; ++it) {
+    int halvings = 0;
+    for (int it = 0; it < options.iterations && halvings < options.max_halvings; ++it) {
       double best = score;
       int best_k = -1;
       std::vector<double> valid_scores;
@@ -283,6 +288,7 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
         ++r.moves;
       } else {
         for (double& s : step) s *= 0.5;
+        ++halvings;
       }
     }
     r.center = f.origin + p[0] * f.ray;

@@ -13,7 +13,8 @@
 //          n = cos(pitch) sin(yaw) e_x + sin(pitch) e_y + cos(pitch) cos(yaw) e_z.
 // Each iteration scores p +- step_k on each parameter (order +t, -t, +yaw,
 // -yaw, +pitch, -pitch), moves to the best candidate if it strictly beats the
-// current mean NCC, and otherwise halves all steps. A candidate is invalid
+// current mean NCC, and otherwise halves all steps, stopping early after
+// max_halvings halvings. A candidate is invalid
 // (never accepted) when any view's NCC is NaN or |yaw| or |pitch| exceeds
 // max_angle_deg.
 
@@ -47,6 +48,8 @@ struct PatchRefinerOptions {
   int work_group_size = kDefaultWorkGroupSize;
   // Search rounds, each scoring 6 candidates; 0 to kMaxRefineIterations.
   int iterations = kDefaultRefineIterations;
+  // Stop after the steps were halved this many times (converged); >= 1.
+  int max_halvings = kDefaultRefineHalvings;
   // Initial step of t, in footprints (depth / f of the reference camera at
   // the initial centre); finite and > 0.
   double depth_step = kDefaultRefineDepthStep;

@@ -51,11 +51,12 @@ Propagator::Propagator(const MatchGroupData& group, const MatcherOptions& option
 bool Propagator::IsBarrier(int image, int x, int y, const AcceptedPatch& patch) const {
   if (edges_.empty() || edges_[image].matched.empty()) return false;
   if (!edges_[image].matched.at<uint8_t>(y, x)) return false;
-  const cv::Vec3f p = edges_[image].points.at<cv::Vec3f>(y, x);
+  const auto found = edges_[image].points.find(y * edges_[image].matched.cols + x);
+  if (found == edges_[image].points.end()) return false;
+  const Eigen::Vector3d p = found->second.cast<double>();
   const Camera& cam = group_.images[image].camera;
   const double footprint = cam.Depth(patch.center) / cam.intrinsics().MeanFocal();
-  const double off_plane =
-      std::abs(patch.normal.dot(Eigen::Vector3d(p[0], p[1], p[2]) - patch.center));
+  const double off_plane = std::abs(patch.normal.dot(p - patch.center));
   return off_plane > options_.depth_tolerance * footprint;
 }
 

@@ -127,14 +127,15 @@ bool improves(float score, float best) { return !isnan(score) && (isnan(best) ||
 // footprints (depth / f at the initial centre) for t, angle_step radians for
 // both angles. Each of `iterations` rounds scores the 6 candidates
 // p +- step_k e_k (in the order +t, -t, +yaw, -yaw, +pitch, -pitch), moves to
-// the best if it strictly beats the current score, else halves every step.
+// the best if it strictly beats the current score, else halves every step;
+// the search ends early after max_halvings halvings (converged).
 // A candidate with |yaw| or |pitch| above max_angle is invalid (NaN).
 __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch_refine(
     __global const float* restrict images, __global const int4* restrict image_table,
     __global const NccCamera* restrict cameras, const int num_images,
     __global const NccPatch* restrict patches, const int num_patches,
     __global const int* restrict view_offsets, __global const int* restrict view_indices,
-    const int iterations, const float depth_step, const float angle_step, const float max_angle,
+    const int iterations, const int max_halvings, const float depth_step, const float angle_step, const float max_angle,
     __global RefinedPatchOut* restrict results, __global float* restrict view_scores) {
   const int i = (int)get_global_id(0);
   if (i >= num_patches) {
@@ -188,7 +189,8 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
     }
   }
   int moves = 0;
-  for (int it = 0; it < iterations; ++it) {
+  int halvings = 0;
+  for (int it = 0; it < iterations && halvings < max_halvings; ++it) {
     float best = score;
     int best_k = -1;
     for (int k = 0; k < 6; ++k) {
@@ -219,6 +221,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
       for (int k = 0; k < 3; ++k) {
         step[k] *= 0.5f;
       }
+      ++halvings;
     }
   }
   out.center = (float4)(origin + p[0] * ray, score);

@@ -109,6 +109,7 @@ TEST(PatchRefinerOptionsTest, CheckRejectsBadValues) {
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.work_group_size = 0; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.iterations = -1; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.iterations = kMaxRefineIterations + 1; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.max_halvings = 0; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.depth_step = 0.0; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.depth_step = std::nan(""); }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.angle_step_deg = 60.0; }));
@@ -217,6 +218,42 @@ TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
       EXPECT_NEAR(start[i].patch.normal.s[k], patches[i].normal.s[k], 1e-5);
     }
   }
+}
+
+// The search stops once its steps were halved max_halvings times: with one
+// halving allowed a search ends at its first failed round, so it takes at
+// most as many moves as with the default, and kernel and reference stop at
+// the same round. With the default, the patches still reach the plane.
+TEST_F(PatchRefinerTest, StopsAfterMaxHalvings) {
+  // The scene of ConvergesToThePlaneAndMatchesReference.
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 12, 2.5, 15.0, 52, &patches, &views);
+  PatchRefinerOptions options;
+  options.patch_size = 11;
+  options.iterations = 200;
+  options.max_halvings = 1;
+  std::vector<RefinedPatch> once;
+  // Checks moves and parameters against the reference where its decisions
+  // are clear.
+  RefineAndCompare(scene, patches, views, options, &once);
+  options.max_halvings = kDefaultRefineHalvings;
+  std::vector<RefinedPatch> converged;
+  RefineAndCompare(scene, patches, views, options, &converged);
+  int fewer = 0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    // A search without a halving limit would run all 200 rounds; a stopped
+    // one ran moves + 1 rounds, and moves never reach 200 here.
+    EXPECT_LT(once[i].moves, options.iterations);
+    EXPECT_LE(once[i].moves, converged[i].moves);
+    fewer += once[i].moves < converged[i].moves;
+    const Eigen::Vector3d center(converged[i].patch.center.s[0], converged[i].patch.center.s[1],
+                                 converged[i].patch.center.s[2]);
+    EXPECT_LT(DepthErrorFootprints(scene.cameras[0], center), 0.5) << "patch " << i;
+  }
+  // Stopping at the first failed round must cut some searches short.
+  EXPECT_GT(fewer, 0);
 }
 
 // Sample weights (sigma_color 3, the matcher's default): the weighted search

@@ -52,10 +52,16 @@ TEST_F(TiePointsTest, LieOnTheTrueSurface) {
   }
   ASSERT_GE(dz.size(), points.size() * 9 / 10);
   std::sort(dz.begin(), dz.end());
-  // Matched at full size on tiny (640 px): measured median 0.55 GSD, 80th
-  // percentile 0.7 GSD (64 points; the strips overlap little sideways).
-  EXPECT_LT(dz[dz.size() / 2], gsd) << points.size() << " points";
-  EXPECT_LT(dz[dz.size() * 8 / 10], 3 * gsd);
+  // Tie points are matched on images halved to at most max_side (tiny's 640
+  // px once, to 320), so their precision is that level's pixel: measured
+  // median 0.54 level GSD (1.08 full-resolution GSD), 75 points; at full
+  // size it was 0.55 full-resolution GSD.
+  int level = 0;
+  const int side = std::max(block.images[0].camera.width(), block.images[0].camera.height());
+  while ((side >> level) > TiePointOptions().max_side) ++level;
+  const double level_gsd = std::ldexp(gsd, level);
+  EXPECT_LT(dz[dz.size() / 2], level_gsd) << points.size() << " points";
+  EXPECT_LT(dz[dz.size() * 8 / 10], 3 * level_gsd);
 }
 
 TEST_F(TiePointsTest, GiveTheFlyingHeightWithoutAPrior) {

@@ -54,7 +54,9 @@ long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group
 
 // How many points of `from` have a point of `to` within `radius` (3D): one
 // cloud's coverage of another, as profiling/versus_pmvs2 compares clouds of
-// different matchers. radius > 0.
-long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius);
+// different matchers. radius > 0. `has`, if given, receives the answer per
+// point of `from`.
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
+                        std::vector<bool>* has = nullptr);
 
 }  // namespace sapmvs

@@ -47,6 +47,12 @@ inline constexpr int kMaxLevel = 6;
 // (started 2.5 footprints and 15 degrees off) to convergence; more change the
 // result by less than 1e-3 NCC there.
 inline constexpr int kDefaultRefineIterations = 24;
+// A search stops early once its steps have been halved this many times: 8
+// leaves depth steps of 1/256 footprint and angle steps of 0.03 degrees, far
+// below what an NCC of float32 samples can tell apart, while the search used
+// to spend most of its 24 rounds halving steps already that fine (on `small`,
+// 40 % less refinement work, the same cloud within 1 GSD).
+inline constexpr int kDefaultRefineHalvings = 8;
 // Largest iteration count accepted; bounds one work-item's run time.
 inline constexpr int kMaxRefineIterations = 1000;
 // Initial depth step, in reference-pixel footprints (depth / f).

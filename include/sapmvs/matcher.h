@@ -127,6 +127,7 @@ struct MatcherOptions {
 struct StageTime {
   double wall = 0;
   double device = 0;
+  double peak_rss_bytes = 0;  // the process's peak so far, at the stage's end
 };
 
 struct KernelTime {
@@ -134,7 +135,8 @@ struct KernelTime {
   long items = 0;  // work items: patches (refinement) or (patch, view) pairs (scoring)
   // NCC evaluations of one patch in one view pair, each over patch_size^2
   // samples: one per pair for scoring; for refinement the upper bound
-  // sum over patches of views * (1 + 6 * iterations) (a candidate that
+  // sum over patches of views * (1 + 6 * rounds), rounds = min(iterations,
+  // moves + max_halvings) (a candidate that
   // leaves the image stops early).
   double ncc_evaluations = 0;
   int patch_size = 0;

@@ -1,0 +1,12 @@
+#pragma once
+// What the process holds in memory, for the reports and the memory budget.
+
+namespace sapmvs {
+
+// Peak resident set size of this process so far, bytes (getrusage).
+double PeakRssBytes();
+
+// Resident set size now, bytes (/proc/self/statm); 0 where unknown.
+double CurrentRssBytes();
+
+}  // namespace sapmvs
