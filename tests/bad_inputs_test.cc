@@ -189,5 +189,24 @@ TEST(BadInputsDoc, InfoSaysWhyCamerasLookingUpHaveNoGsd) {
   fs::remove_all(dir);
 }
 
+// `run` used to match such a block and fail at the end with an internal
+// "merge radius = 0"; it must stop before any work, writing nothing.
+TEST(BadInputsDoc, RunRefusesCamerasLookingUpBeforeAnyWork) {
+  const fs::path dir = ScratchDir();
+  WriteYamlFixture(dir);
+  ReplaceInFile(dir / "orientation.txt", "100 0 0 0", "100 180 0 0");
+  const CliResult r =
+      RunCli("run " + (dir / "block.yaml").string() + " --out " + (dir / "out").string());
+  if (r.exit_code == 2) GTEST_SKIP() << "no OpenCL device, run stopped before the block: " << r.err;
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(": no image sees the ground height (Z = 0.000): the optical axes of 'a', "
+                       "'b' do not meet it (2 of 2 cameras look up)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "out" / "cloud.ply"));
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace sapmvs::test
