@@ -46,7 +46,9 @@ Camera ReadCameraFile(const fs::path& path, std::string* name) {
     throw InputError(path.string(), k(0, 0) > 0 ? 2 : 1, s.str());
   }
   if (std::abs(k(0, 1)) > 1e-3 * k(0, 0)) {
-    throw InputError(path.string(), 1, "skewed K is not supported");
+    std::ostringstream s;
+    s << "skew " << k(0, 1) << " in K is not supported (expected K = [fx 0 cx; 0 fy cy; 0 0 1])";
+    throw InputError(path.string(), 1, s.str());
   }
   Intrinsics in = Intrinsics::FromPixels(k(0, 0), k(1, 1), k(0, 2), k(1, 2), w, h);
   in.distortion.k1 = dist[0];
