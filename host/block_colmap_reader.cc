@@ -130,6 +130,7 @@ Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
   block.frame_note = "COLMAP model frame";
   TextLines lines(dir / "images.txt");
   std::string line;
+  std::map<std::string, int> first_line;  // image name -> line in images.txt
   while (lines.NextRaw(&line)) {
     const std::vector<std::string> t = SplitWhitespace(line);
     if (t.empty()) continue;
@@ -147,6 +148,10 @@ Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
     BlockImage im;
     im.name = t[9];
     for (size_t i = 10; i < t.size(); ++i) im.name += " " + t[i];
+    if (const auto [it, fresh] = first_line.emplace(im.name, lines.line()); !fresh) {
+      throw lines.Fail("image '" + im.name + "' listed twice (first on line " +
+                       std::to_string(it->second) + ")");
+    }
     im.camera_name = "camera " + t[8];
     const Eigen::Matrix3d r = q.normalized().toRotationMatrix();
     const Eigen::Vector3d tr(v[4], v[5], v[6]);

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 
 #include "sapmvs/dem.h"
+#include "sapmvs/error.h"
 
 namespace sapmvs {
 namespace {
@@ -45,6 +47,35 @@ std::optional<double> MedianDepth(const Camera& cam, const std::vector<Eigen::Ve
 }
 
 }  // namespace
+
+std::string NoSurfaceReason(const Block& block, const BlockGeometry& g) {
+  if (g.num_valid > 0) return "";
+  const std::string where = block.source.string() + ": ";
+  if (g.source == SurfaceSource::kNone) {
+    return where +
+           "no surface estimate (no DEM, sparse points or ground height, and too few tie "
+           "points); expected one: give --ground-height, or add ground_height or dem to the block";
+  }
+  std::string names;
+  int up = 0;
+  const size_t shown = std::min<size_t>(block.images.size(), 3);
+  for (size_t i = 0; i < shown; ++i) names += (i ? ", '" : "'") + block.images[i].name + "'";
+  if (block.images.size() > shown)
+    names += " and " + std::to_string(block.images.size() - shown) + " more";
+  for (const BlockImage& im : block.images) up += im.camera.ViewingDirection().z() > 0;
+  std::string what = "the " + ToString(g.source);
+  if (g.source == SurfaceSource::kGroundHeight && block.ground_height) {
+    char z[64];
+    std::snprintf(z, sizeof(z), " (Z = %.3f)", *block.ground_height);
+    what += z;
+  }
+  return where + "no image sees " + what + ": the optical axes of " + names + " do not meet it" +
+         (up > 0 ? " (" + std::to_string(up) + " of " + std::to_string(block.images.size()) +
+                       " cameras look up)"
+                 : "") +
+         "; expected cameras looking at the scene (check the orientation's angles and "
+         "convention)";
+}
 
 std::string ToString(SurfaceSource source) {
   switch (source) {

@@ -9,8 +9,10 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
+#include "input_file.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
@@ -21,20 +23,71 @@ namespace {
 
 using json = nlohmann::json;
 
+// nlohmann's what() starts with "[json.exception.parse_error.101] "; the user
+// needs only the rest.
+std::string JsonDetail(const json::exception& e) {
+  std::string s = e.what();
+  if (!s.empty() && s[0] == '[') {
+    const size_t end = s.find("] ");
+    if (end != std::string::npos) s = s.substr(end + 2);
+  }
+  return s;
+}
+
+// Thrown by the parser callback at a key an object already holds: nlohmann
+// would keep one of the two silently, and for shots that drops an image.
+struct DuplicateKey {
+  std::string key;
+};
+
 // JSON values carry no line numbers; errors name the JSON path and the line
 // where the nearest enclosing key first appears in the file.
 class JsonFile {
  public:
   explicit JsonFile(const fs::path& path) : path_(path.string()) {
-    std::ifstream in(path);
-    if (!fs::is_regular_file(path) || !in) throw Error(path_ + ": cannot open file");
+    std::ifstream in = OpenInputFile(path);
     std::stringstream ss;
     ss << in.rdbuf();
     text_ = ss.str();
+    std::vector<std::set<std::string>> keys;  // per open object
+    const json::parser_callback_t check_keys = [&keys](int, json::parse_event_t event,
+                                                       json& parsed) {
+      if (event == json::parse_event_t::object_start) {
+        keys.emplace_back();
+      } else if (event == json::parse_event_t::object_end) {
+        keys.pop_back();
+      } else if (event == json::parse_event_t::key && !keys.empty()) {
+        if (!keys.back().insert(parsed.get<std::string>()).second) {
+          throw DuplicateKey{parsed.get<std::string>()};
+        }
+      }
+      return true;
+    };
     try {
-      root_ = json::parse(text_);
+      root_ = json::parse(text_, check_keys);
+    } catch (const DuplicateKey& d) {
+      const std::string quoted = "\"" + d.key + "\"";
+      const size_t first = text_.find(quoted);
+      const size_t second = text_.find(quoted, first + 1);
+      throw InputError(path_, second == std::string::npos ? 0 : LineAt(second + 1),
+                       "key '" + d.key + "' appears twice in one object (first on line " +
+                           std::to_string(LineAt(first + 1)) + "); expected unique names");
     } catch (const json::parse_error& e) {
-      throw InputError(path_, LineAt(e.byte), std::string("not valid JSON: ") + e.what());
+      // "parse error at line L, column C: what": keep the column and what.
+      std::string detail = JsonDetail(e);
+      const size_t column = detail.find("column ");
+      if (column != std::string::npos) detail = "at " + detail.substr(column);
+      throw InputError(path_, LineAt(e.byte), "not valid JSON " + detail);
+    } catch (const json::out_of_range& e) {
+      // A number beyond double's range (1e999); the message quotes it.
+      const std::string detail = JsonDetail(e);
+      const size_t open = detail.find('\''), close = detail.rfind('\'');
+      const std::string number = open != std::string::npos && close > open
+                                     ? detail.substr(open + 1, close - open - 1)
+                                     : "";
+      const size_t at = number.empty() ? std::string::npos : text_.find(number);
+      throw InputError(path_, at == std::string::npos ? 0 : LineAt(at + 1),
+                       "number " + number + " is out of range (expected a finite number)");
     }
   }
 
@@ -86,6 +139,8 @@ class JsonFile {
 Intrinsics ReadCamera(const JsonFile& f, const std::string& id, const json& c) {
   const std::string where = "cameras/" + id;
   if (!c.is_object()) f.Fail(id, where, "expected an object");
+  if (c.contains("projection_type") && !c["projection_type"].is_string())
+    f.Fail(id, where + "/projection_type", "expected a string");
   const std::string type = c.value("projection_type", "");
   const int w = static_cast<int>(f.Number(c, "width", where, id));
   const int h = static_cast<int>(f.Number(c, "height", where, id));
@@ -126,8 +181,9 @@ fs::path JsonPath(const fs::path& given) {
 
 }  // namespace
 
-Block ReadOpenSfmBlock(const fs::path& given, const BlockReadOptions& options) {
-  const fs::path path = JsonPath(given);
+namespace {
+
+Block ReadOpenSfmFile(const fs::path& path, const BlockReadOptions& options) {
   const JsonFile f(path);
   const json& root = f.root();
   if (!root.is_array() || root.empty() || !root[0].is_object()) {
@@ -192,6 +248,19 @@ Block ReadOpenSfmBlock(const fs::path& given, const BlockReadOptions& options) {
     }
   }
   return block;
+}
+
+}  // namespace
+
+Block ReadOpenSfmBlock(const fs::path& given, const BlockReadOptions& options) {
+  const fs::path path = JsonPath(given);
+  try {
+    return ReadOpenSfmFile(path, options);
+  } catch (const json::exception& e) {
+    // A value of a type the checks above did not foresee: still one line
+    // naming the file, without the library's prefix.
+    throw InputError(path.string(), 0, "unexpected JSON content: " + JsonDetail(e));
+  }
 }
 
 }  // namespace sapmvs

@@ -5,6 +5,7 @@
 // A folder `sapmvs export` wrote is in the block's local frame; its side file
 // (export_frame.h) puts the cameras back into the world frame.
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cctype>
 
@@ -36,6 +37,8 @@ Block ReadPmvsBlock(const fs::path& given, const BlockReadOptions& options) {
 
   Block block;
   block.frame_note = "PMVS frame (as given by the projection matrices)";
+  // Files whose P has a left 3x3 block of negative or positive determinant.
+  std::vector<fs::path> negative, positive;
   for (const fs::path& file : files) {
     TextLines lines(file);
     std::vector<std::string> t;
@@ -52,6 +55,7 @@ Block ReadPmvsBlock(const fs::path& given, const BlockReadOptions& options) {
         p(r, c) = lines.Double(t[c], "P" + std::to_string(r + 1) + std::to_string(c + 1));
     }
     if (lines.Next(&t)) throw lines.Fail("unexpected extra content after the 3x4 matrix");
+    (Eigen::Matrix3d(p.leftCols<3>()).determinant() < 0 ? negative : positive).push_back(file);
     BlockImage im;
     im.name = file.stem().string();
     im.camera_name = im.name;
@@ -66,6 +70,22 @@ Block ReadPmvsBlock(const fs::path& given, const BlockReadOptions& options) {
       throw InputError(file.string(), 2, e.what());
     }
     block.images.push_back(std::move(im));
+  }
+  // P's scale is arbitrary and may be negative (VisualSFM), which makes the
+  // determinant negative; the reader then flips P. But one camera of another
+  // sign than the rest has a negative focal length (a mirrored camera) or a
+  // flipped P, and reading it as given would turn it to look away.
+  if (!negative.empty() && !positive.empty()) {
+    const bool few_negative = negative.size() <= positive.size();
+    const std::vector<fs::path>& odd = few_negative ? negative : positive;
+    const std::vector<fs::path>& rest = few_negative ? positive : negative;
+    throw InputError(
+        odd.front().string(), 2,
+        std::string("negative focal length or P of the wrong sign: det of P's left 3x3 block is ") +
+            (few_negative ? "negative" : "positive") + ", but " +
+            (few_negative ? "positive" : "negative") + " for " + rest.front().filename().string() +
+            (rest.size() > 1 ? " and " + std::to_string(rest.size() - 1) + " more" : "") +
+            " (expected P = s K [R, t] with fx, fy > 0 and one sign of s for all cameras)");
   }
   if (frame) ApplyExportFrame(*frame, root, "pmvs", &block);
   return block;

@@ -4,8 +4,10 @@
 #include <cctype>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <sstream>
 
+#include "input_file.h"
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
 
@@ -84,6 +86,7 @@ bool BlockReadOptions::Check() const {
 
 BlockFormat DetectBlockFormat(const fs::path& path) {
   if (!fs::exists(path)) throw Error(path.string() + ": block not found (no such file or folder)");
+  if (!fs::is_directory(path)) RequireRegularFile(path);  // a FIFO would block the reader
   if (fs::is_regular_file(path)) {
     const std::string ext = path.extension().string();
     const std::string name = path.filename().string();
@@ -145,6 +148,16 @@ Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
   if (options.ground_height) block.ground_height = options.ground_height;
   block.format = ToString(format);
   if (block.images.empty()) throw Error(path.string() + ": block has no images");
+  // Two images on one file (names that differ only in the extension the
+  // reader adds, a.jpg and a) would match a picture with itself.
+  std::map<fs::path, const BlockImage*> by_file;
+  for (const BlockImage& im : block.images) {
+    const auto [it, fresh] = by_file.emplace(im.path.lexically_normal(), &im);
+    if (!fresh) {
+      throw Error(im.path.string() + ": the file of both image '" + it->second->name +
+                  "' and image '" + im.name + "' (expected one file per image)");
+    }
+  }
   for (const BlockImage& im : block.images) {
     im.camera.intrinsics().Validate("image '" + im.name + "'");
     if (!im.camera.center().allFinite() || !im.camera.rotation().allFinite()) {

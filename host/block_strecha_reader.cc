@@ -4,6 +4,8 @@
 // so that P = K [R^T | -R^T C] with the OpenCV camera frame.
 
 #include <algorithm>
+#include <map>
+#include <sstream>
 
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
@@ -38,8 +40,15 @@ Camera ReadCameraFile(const fs::path& path, std::string* name) {
   const int w = lines.Int(t[0], "width"), h = lines.Int(t[1], "height");
   if (w <= 0 || h <= 0) throw lines.Fail("expected a positive image size W H");
   if (lines.Next(&t)) throw lines.Fail("unexpected extra content after W H");
+  if (!(k(0, 0) > 0 && k(1, 1) > 0)) {
+    std::ostringstream s;
+    s << "expected positive focal lengths in K, got fx = " << k(0, 0) << ", fy = " << k(1, 1);
+    throw InputError(path.string(), k(0, 0) > 0 ? 2 : 1, s.str());
+  }
   if (std::abs(k(0, 1)) > 1e-3 * k(0, 0)) {
-    throw InputError(path.string(), 1, "skewed K is not supported");
+    std::ostringstream s;
+    s << "skew " << k(0, 1) << " in K is not supported (expected K = [fx 0 cx; 0 fy cy; 0 0 1])";
+    throw InputError(path.string(), 1, s.str());
   }
   Intrinsics in = Intrinsics::FromPixels(k(0, 0), k(1, 1), k(0, 2), k(1, 2), w, h);
   in.distortion.k1 = dist[0];
@@ -83,6 +92,7 @@ Block ReadStrechaBlock(const fs::path& given, const BlockReadOptions& options) {
   }
   Block block;
   block.frame_note = "Strecha ground-truth frame (metres)";
+  std::map<fs::path, fs::path> described_by;  // image file -> its .camera file
   for (const fs::path& file : files) {
     BlockImage im;
     im.camera = ReadCameraFile(file, &im.name);
@@ -90,6 +100,12 @@ Block ReadStrechaBlock(const fs::path& given, const BlockReadOptions& options) {
     im.path = FindImageFile(image_dir, im.name);
     if (im.path.empty()) {
       throw InputError(file.string(), 0, "no image '" + im.name + "' in " + image_dir.string());
+    }
+    if (const auto [it, fresh] = described_by.emplace(im.path, file); !fresh) {
+      throw InputError(file.string(), 0,
+                       "image " + im.path.filename().string() + " is already described by " +
+                           it->second.filename().string() +
+                           " (expected one .camera file per image)");
     }
     block.images.push_back(std::move(im));
   }

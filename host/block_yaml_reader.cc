@@ -24,6 +24,7 @@
 
 #include <map>
 
+#include "input_file.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
@@ -179,7 +180,7 @@ class ImageLocator {
 Block ReadYamlBlock(const fs::path& given, const BlockReadOptions& options) {
   const fs::path path = fs::is_directory(given) ? given / "block.yaml" : given;
   const YamlFile f(path);
-  if (!fs::is_regular_file(path)) throw Error(path.string() + ": block file not found");
+  RequireRegularFile(path);
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());

@@ -21,7 +21,7 @@ void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global) {
       ->required();
   cmd->add_option("--radius", o->radius,
                   "LiDAR: XY search radius d, CRS units (default: 2 x the LiDAR's median "
-                  "nearest-neighbour spacing)");
+                  "nearest-neighbour spacing; at most 50 x)");
   cmd->add_option("--tolerance", o->tolerance,
                   "|dz| counted as within tolerance, CRS units (the paper's 1 m; use block "
                   "units for a block without a metric frame)")

@@ -73,8 +73,9 @@ void PrintInfo(const Block& block, std::ostream& out) {
   if (g.source == SurfaceSource::kTiePoints) out << " (" << g.tie_points.size() << " points)";
   out << "\n";
   if (g.num_valid == 0) {
-    out << "GSD            unknown: no surface estimate (no DEM, sparse points or ground "
-           "height, and too few tie points; give --ground-height)\n";
+    // Not an error here: info shows what the block holds, and this is why
+    // run and plan would refuse it.
+    out << "GSD            unknown: " << NoSurfaceReason(block, g) << "\n";
     return;
   }
   out << "GSD            "

@@ -49,7 +49,8 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
   cmd->add_option("--level", g.level, "Pyramid level the groups are matched at (memory estimate)")
       ->capture_default_str();
   cmd->add_option("--tile-size", g.tile_size,
-                  "footprint: tile side, in median footprint shorter sides")
+                  "footprint: tile side, in median footprint shorter sides (tiles of at least "
+                  "64 px and at most 100,000 of them)")
       ->capture_default_str();
   cmd->add_option("--tile-views", g.tile_views,
                   "footprint: images a tile's points should be seen in")

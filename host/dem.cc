@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 
+#include "input_file.h"
 #include "sapmvs/error.h"
 
 namespace sapmvs {
@@ -15,6 +16,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
 Dem Dem::Load(const std::filesystem::path& path) {
+  RequireRegularFile(path);
   GDALAllRegister();
   std::unique_ptr<GDALDataset> ds(
       GDALDataset::Open(path.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));

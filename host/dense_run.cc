@@ -146,6 +146,10 @@ RunReport RunDense(const RunOptions& options) {
   const Block block = ReadBlock(options.block, options.read);
   report.images = static_cast<int>(block.images.size());
   const BlockGeometry geometry = EstimateBlockGeometry(block);
+  // Without a GSD the merge radius would be 0, found only after matching.
+  if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
+    throw Error(reason);
+  }
   const GroupingOptions gopt = options.Grouping();
   GroupingPlan plan;
   ImageGroup all;

@@ -197,6 +197,14 @@ EvaluationReport EvaluateAgainstLidar(std::vector<Eigen::Vector3d> cloud,
   const LidarReference reference(lidar);
   r.spacing = reference.MedianSpacing();
   if (options.radius > 0) {
+    // The mean over thousands of LiDAR points is no height at a point, and
+    // each query would cost as many.
+    if (std::isfinite(r.spacing) && options.radius > kMaxRadiusPerSpacing * r.spacing) {
+      throw Error("evaluate: --radius " + Num(options.radius) + " is " +
+                  Num(std::round(options.radius / r.spacing)) + " x the LiDAR's point spacing (" +
+                  Num(r.spacing) + "); expected at most " + Num(kMaxRadiusPerSpacing) +
+                  " x (--radius <= " + Num(kMaxRadiusPerSpacing * r.spacing) + ")");
+    }
     r.radius = options.radius;
     r.radius_note = "given with --radius";
   } else {

@@ -237,6 +237,38 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
   }
 }
 
+// Every tile costs kTileSamples^2 point-in-quad tests per image, so a tiny
+// --tile-size (1e-6) would plan for hours. A tile narrower than
+// kMinTilePixels image pixels holds too few patches to be worth a group, and
+// the tile count is capped so that planning stays within seconds.
+constexpr double kMinTilePixels = 64;
+constexpr double kMaxTiles = 100000;
+
+void CheckTileCost(const Block& block, const GroupingOptions& o, const std::vector<int>& valid,
+                   const Eigen::Vector2d& tiles_xy) {
+  std::vector<double> px;
+  for (int i : valid) {
+    const Camera& c = block.images[i].camera;
+    px.push_back(std::min(c.width(), c.height()));
+  }
+  std::nth_element(px.begin(), px.begin() + px.size() / 2, px.end());
+  const double short_px = px[px.size() / 2];
+  const double tiles =
+      std::max(1.0, std::ceil(tiles_xy.x())) * std::max(1.0, std::ceil(tiles_xy.y()));
+  const double min_size =
+      std::max(kMinTilePixels / short_px, o.tile_size * std::sqrt(tiles / kMaxTiles));
+  if (o.tile_size * short_px < kMinTilePixels || tiles > kMaxTiles) {
+    std::ostringstream s;
+    s.precision(3);
+    s << "--tile-size " << o.tile_size << " gives tiles of " << o.tile_size * short_px
+      << " px (the median image's shorter side is " << short_px << " px) and " << tiles
+      << " tiles; expected tiles of at least " << static_cast<int>(kMinTilePixels)
+      << " px and at most " << static_cast<long>(kMaxTiles) << " tiles: --tile-size in ["
+      << std::min(4.0, min_size) << ", 4]";
+    throw Error(s.str());
+  }
+}
+
 void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeometry& geometry,
                    const std::vector<Footprint>& fp, GroupingPlan* plan) {
   if (!geometry.aerial) {
@@ -260,6 +292,7 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
   std::nth_element(sides.begin(), sides.begin() + sides.size() / 2, sides.end());
   const double side = o.tile_size * sides[sides.size() / 2];
   const Eigen::Vector2d size = hi - lo;
+  CheckTileCost(block, o, valid, size / side);
   const int nx = std::max(1, static_cast<int>(std::ceil(size.x() / side - 1e-9)));
   const int ny = std::max(1, static_cast<int>(std::ceil(size.y() / side - 1e-9)));
   // Tiles split the extent evenly, so the last ones are not slivers.
@@ -447,6 +480,9 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   plan.options = options;
   plan.strips = DetectStrips(block);
   const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
+  if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
+    throw Error(reason);
+  }
   const std::vector<Footprint> fp = Footprints(block, geometry);
   if (options.strategy == GroupingStrategy::kStrip)
     PlanStrips(block, options, fp, &plan);

@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <fstream>
 #include <memory>
 #include <mutex>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "input_file.h"
 #include "sapmvs/error.h"
 
 namespace sapmvs {
@@ -31,6 +33,48 @@ std::string LowerExtension(const std::filesystem::path& p) {
   return ext;
 }
 
+// A regular, non-empty file; otherwise throws naming the image.
+void RequireImageFile(const std::filesystem::path& path, const std::string& image) {
+  const std::string problem = NotRegularFile(path);
+  const std::string suffix = image.empty() ? "" : " (image '" + image + "')";
+  if (problem == "missing") throw Error(path.string() + ": image file not found" + suffix);
+  if (!problem.empty()) {
+    throw Error(path.string() + ": cannot open image (" + problem + ", expected a regular file)" +
+                suffix);
+  }
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) == 0 && !ec) {
+    throw Error(path.string() + ": empty file (0 bytes), expected an image" + suffix);
+  }
+}
+
+// libjpeg decodes a truncated JPEG with only a warning on stderr and grey
+// rows for the missing part, so a cut-off file would be matched as if it were
+// whole. A complete JPEG ends with the EOI marker FF D9; entropy-coded data
+// cannot hold FF D9 (an FF there is followed by 00 or a restart marker), so an
+// EOI near the end means the file is whole. The tail allows for padding or
+// trailer data some cameras write after EOI.
+void CheckJpegComplete(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char soi[2] = {0, 0};
+  if (!in.read(reinterpret_cast<char*>(soi), 2) || soi[0] != 0xFF || soi[1] != 0xD8) return;
+  constexpr std::streamoff kTail = 4096;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  const std::streamoff start = std::max<std::streamoff>(2, size - kTail);
+  std::vector<char> tail(static_cast<size_t>(size - start));
+  in.seekg(start);
+  if (!in.read(tail.data(), static_cast<std::streamsize>(tail.size()))) return;
+  for (size_t i = 0; i + 1 < tail.size(); ++i) {
+    if (static_cast<unsigned char>(tail[i]) == 0xFF &&
+        static_cast<unsigned char>(tail[i + 1]) == 0xD9) {
+      return;
+    }
+  }
+  throw Error(path.string() + ": truncated JPEG (" + std::to_string(size) +
+              " bytes, no end-of-image marker), expected a complete image");
+}
+
 }  // namespace
 
 bool HasImageExtension(const std::filesystem::path& path) {
@@ -43,36 +87,51 @@ bool HasImageExtension(const std::filesystem::path& path) {
 
 ImageSize ReadImageSize(const std::filesystem::path& path) {
   RegisterGdalOnce();
-  if (!std::filesystem::is_regular_file(path)) {
-    throw Error(path.string() + ": image file not found");
-  }
+  RequireImageFile(path, "");
+  CheckJpegComplete(path);
+  CPLErrorReset();
   std::unique_ptr<GDALDataset> ds(
       GDALDataset::Open(path.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
-  if (!ds) throw Error(path.string() + ": not a readable image (" + CPLGetLastErrorMsg() + ")");
+  if (!ds) {
+    const std::string detail = CPLGetLastErrorMsg();
+    throw Error(path.string() + ": not a readable image" +
+                (detail.empty()
+                     ? std::string(" (expected TIFF, JPEG, PNG, PPM/PGM, BMP or JPEG 2000)")
+                     : " (" + detail + ")"));
+  }
   return {ds->GetRasterXSize(), ds->GetRasterYSize()};
 }
 
 std::filesystem::path FindImageFile(const std::filesystem::path& folder, const std::string& name) {
   namespace fs = std::filesystem;
-  if (fs::is_regular_file(folder / name)) return folder / name;
+  // Not only regular files: a FIFO or a link to nothing is found here and
+  // refused by name where it is opened, instead of reported as missing.
+  if (fs::exists(fs::symlink_status(folder / name)) && !fs::is_directory(folder / name)) {
+    return folder / name;
+  }
   if (!fs::is_directory(folder)) return {};
   const std::string stem = fs::path(name).stem().string();
   std::vector<fs::path> hits;
   for (const auto& entry : fs::directory_iterator(folder)) {
-    if (!entry.is_regular_file() || !HasImageExtension(entry.path())) continue;
+    if (entry.is_directory() || !HasImageExtension(entry.path())) continue;
     const std::string s = entry.path().stem().string();
     if (s == name || s == stem) hits.push_back(entry.path());
   }
   if (hits.empty()) return {};
-  // Deterministic choice when e.g. both a .tif and a .png copy exist.
-  std::sort(hits.begin(), hits.end());
+  // Two files that both fit (a.jpg and a.png) may hold different pictures;
+  // picking one silently could match the wrong one.
+  if (hits.size() > 1) {
+    std::sort(hits.begin(), hits.end());
+    throw Error(folder.string() + ": image '" + name + "' is ambiguous: " +
+                hits[0].filename().string() + " and " + hits[1].filename().string() +
+                " both fit (expected one file; remove one or give the name with its extension)");
+  }
   return hits.front();
 }
 
 cv::Mat LoadImage(const BlockImage& image) {
-  if (!std::filesystem::is_regular_file(image.path)) {
-    throw Error(image.path.string() + ": image file not found (image '" + image.name + "')");
-  }
+  RequireImageFile(image.path, image.name);
+  CheckJpegComplete(image.path);
   cv::Mat pixels = cv::imread(image.path.string(), cv::IMREAD_COLOR);
   if (pixels.empty()) {
     throw Error(image.path.string() + ": cannot decode image (expected 8-bit RGB or grey)");

@@ -11,6 +11,7 @@
 #include <limits>
 #include <sstream>
 
+#include "input_file.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 #include "sapmvs/raster_io.h"
@@ -312,11 +313,7 @@ void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>&
 
 LasCloud ReadLas(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::error_code ec;
-  std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path, ec) || !in) {
-    throw Error(file + ": cannot open file (missing or unreadable)");
-  }
+  std::ifstream in = OpenInputFile(path, std::ios::binary);
   const uint64_t size = std::filesystem::file_size(path);
   auto fail = [&](const std::string& message) { return InputError(file, 0, message); };
 

@@ -15,6 +15,10 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Queries per FLANN call: bounds the memory of the per-query result vectors.
 constexpr size_t kChunkQueries = 1 << 16;
+// Candidates (index + distance, 12 bytes each) one FLANN call may return,
+// about 200 MB: a large radius finds many points per query, and the chunk
+// shrinks so that the result vectors stay within this.
+constexpr double kChunkCandidates = 16e6;
 // Neighbours asked for when measuring the spacing: enough to step over the
 // returns of one pulse that share its XY.
 constexpr int kSpacingNeighbours = 8;
@@ -107,13 +111,15 @@ std::vector<double> LidarReference::MeanHeights(const std::vector<Eigen::Vector3
   }
   std::vector<double> heights(queries.size(), kNaN);
   const double radius2 = radius * radius;
-  Progress bar("reference heights",
-               static_cast<long>((queries.size() + kChunkQueries - 1) / kChunkQueries), progress);
+  Progress bar("reference heights", static_cast<long>(queries.size()), progress);
   std::vector<float> q;
   std::vector<std::vector<size_t>> indices;
   std::vector<std::vector<float>> dists;
-  for (size_t first = 0; first < queries.size(); first += kChunkQueries) {
-    const size_t n = std::min(kChunkQueries, queries.size() - first);
+  // The first chunk is small; later ones are sized from the candidates per
+  // query the previous one found.
+  size_t chunk = 1024;
+  for (size_t first = 0, n = 0; first < queries.size(); first += n) {
+    n = std::min(chunk, queries.size() - first);
     q.resize(2 * n);
     double max_abs = max_abs_coordinate_;
     for (size_t i = 0; i < n; ++i) {
@@ -140,7 +146,12 @@ std::vector<double> LidarReference::MeanHeights(const std::vector<Eigen::Vector3
       }
       if (count > 0) heights[first + i] = sum / static_cast<double>(count);
     }
-    bar.Advance();
+    size_t found = 0;
+    for (size_t i = 0; i < n; ++i) found += indices[i].size();
+    const double per_query = std::max(1.0, static_cast<double>(found) / static_cast<double>(n));
+    chunk = static_cast<size_t>(
+        std::clamp(kChunkCandidates / per_query, 1.0, static_cast<double>(kChunkQueries)));
+    bar.Advance(static_cast<long>(n));
   }
   bar.Finish();
   return heights;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "input_file.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 #include "text_lines.h"
@@ -273,8 +274,18 @@ uint8_t ToColor8(double v, PlyType type) {
   return static_cast<uint8_t>(std::clamp(std::round(v), 0.0, 255.0));
 }
 
-// Stores one decoded value of a vertex property.
-void Assign(CloudPoint* p, Role role, PlyType type, double v) {
+// A double outside float's range converts with undefined behaviour; it
+// becomes an infinity instead.
+float NarrowToFloat(double v) {
+  if (v > std::numeric_limits<float>::max()) return std::numeric_limits<float>::infinity();
+  if (v < -std::numeric_limits<float>::max()) return -std::numeric_limits<float>::infinity();
+  return static_cast<float>(v);
+}
+
+// Stores one decoded value of a vertex property. Returns false for a views
+// value that is no count an int can hold (NaN, 3e38, -1, 2.5): casting it
+// would be undefined behaviour.
+bool Assign(CloudPoint* p, Role role, PlyType type, double v) {
   switch (role) {
     case Role::kX:
       p->position.x() = v;
@@ -286,13 +297,13 @@ void Assign(CloudPoint* p, Role role, PlyType type, double v) {
       p->position.z() = v;
       break;
     case Role::kNx:
-      p->normal.x() = static_cast<float>(v);
+      p->normal.x() = NarrowToFloat(v);
       break;
     case Role::kNy:
-      p->normal.y() = static_cast<float>(v);
+      p->normal.y() = NarrowToFloat(v);
       break;
     case Role::kNz:
-      p->normal.z() = static_cast<float>(v);
+      p->normal.z() = NarrowToFloat(v);
       break;
     case Role::kRed:
       p->color[0] = ToColor8(v, type);
@@ -304,14 +315,22 @@ void Assign(CloudPoint* p, Role role, PlyType type, double v) {
       p->color[2] = ToColor8(v, type);
       break;
     case Role::kScore:
-      p->score = static_cast<float>(v);
+      p->score = NarrowToFloat(v);
       break;
     case Role::kViews:
+      if (!(v >= 0 && v <= std::numeric_limits<int>::max() && v == std::floor(v))) return false;
       p->num_views = static_cast<int>(v);
       break;
     case Role::kSkip:
       break;
   }
+  return true;
+}
+
+std::string BadViews(double v) {
+  std::ostringstream s;
+  s << "views = " << v << " (expected a whole count 0.." << std::numeric_limits<int>::max() << ")";
+  return s.str();
 }
 
 std::string Ordinal(uint64_t i, const PlyElement& e) {
@@ -327,14 +346,17 @@ void ReadBinaryElement(BinaryCursor* in, const std::string& file, const PlyEleme
       bool ok = b != nullptr;
       if (ok && prop.is_list) {
         const double n = LoadScalar(b, prop.count_type, swap);
-        if (n < 0) {
+        if (!(n >= 0 && n <= 1e15)) {
           throw InputError(file, 0,
-                           "negative list length in " + Ordinal(i, e) + ", property '" + prop.name +
-                               "' (corrupt data)");
+                           "bad list length (not a count) in " + Ordinal(i, e) + ", property '" +
+                               prop.name + "' (corrupt data)");
         }
         ok = in->Skip(static_cast<uint64_t>(n) * TypeSize(prop.type));
       } else if (ok && points && prop.role != Role::kSkip) {
-        Assign(&p, prop.role, prop.type, LoadScalar(b, prop.type, swap));
+        const double v = LoadScalar(b, prop.type, swap);
+        if (!Assign(&p, prop.role, prop.type, v)) {
+          throw InputError(file, 0, Ordinal(i, e) + ": " + BadViews(v));
+        }
       }
       if (!ok) {
         throw InputError(
@@ -387,8 +409,8 @@ void ReadAsciiElement(TextLines* lines, const PlyElement& e, std::vector<CloudPo
           throw lines->Fail("bad list length for property '" + prop.name + "'");
         }
         for (double j = 0; j < v; ++j) next(prop);
-      } else if (points) {
-        Assign(&p, prop.role, prop.type, v);
+      } else if (points && !Assign(&p, prop.role, prop.type, v)) {
+        throw lines->Fail(Ordinal(i, e) + ": " + BadViews(v));
       }
     }
     if (k != t.size()) {
@@ -413,10 +435,11 @@ bool Declares(const PlyElement& e, Role role) {
 
 PointCloud ReadPly(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path) || !in) {
-    throw InputError(file, 0, "cannot open file (missing or unreadable; expected a PLY file)");
+  if (const std::string problem = NotRegularFile(path); !problem.empty()) {
+    throw InputError(file, 0, "cannot open file (" + problem + "; expected a PLY file)");
   }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file, 0, "cannot open file (unreadable; expected a PLY file)");
   const PlyHeader h = ReadHeader(in, file);
 
   const auto vertex = std::find_if(h.elements.begin(), h.elements.end(),

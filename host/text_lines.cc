@@ -3,6 +3,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "input_file.h"
+
 namespace sapmvs {
 
 std::vector<std::string> SplitWhitespace(const std::string& line) {
@@ -13,11 +15,8 @@ std::vector<std::string> SplitWhitespace(const std::string& line) {
   return out;
 }
 
-TextLines::TextLines(const std::filesystem::path& path) : in_(path), file_(path.string()) {
-  if (!std::filesystem::is_regular_file(path) || !in_) {
-    throw Error(file_ + ": cannot open file (missing or unreadable)");
-  }
-}
+TextLines::TextLines(const std::filesystem::path& path)
+    : in_(OpenInputFile(path)), file_(path.string()) {}
 
 bool TextLines::NextRaw(std::string* line, bool skip_comments) {
   while (std::getline(in_, *line)) {

@@ -1,6 +1,7 @@
 #include "sapmvs/ply_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -332,6 +333,31 @@ TEST_F(PlyIoTest, NonFiniteBinaryCoordinateIsRefused) {
   const fs::path path = dir_ / "nan.ply";
   WriteBytes(path, b);
   test::ExpectInputError([&] { ReadPly(path); }, "nan.ply", 0, "non-finite coordinate in vertex 1");
+}
+
+// Casting NaN, 3e38, -1 or 2.5 to an int count would be undefined behaviour
+// or a wrong count; the binary path must refuse them as the ASCII one does
+// (docs/bad-inputs.md, PlyViews*).
+TEST_F(PlyIoTest, BinaryViewsThatAreNoCountAreRefused) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+      "property float y\nproperty float z\nproperty float views\nend_header\n";
+  for (const float views : {std::numeric_limits<float>::quiet_NaN(), 3e38f, -1.0f, 2.5f}) {
+    Bytes b(header.begin(), header.end());
+    const float v[8] = {1, 2, 3, 4, 4, 5, 6, views};
+    const uint8_t* raw = reinterpret_cast<const uint8_t*>(v);
+    b.insert(b.end(), raw, raw + sizeof v);
+    const fs::path path = dir_ / "views.ply";
+    WriteBytes(path, b);
+    test::ExpectInputError([&] { ReadPly(path); }, "views.ply", 0,
+                           "vertex 1 of 2 (0-based): views = ");
+  }
+}
+
+TEST_F(PlyIoTest, FifoIsRefusedWithoutBlocking) {
+  const fs::path path = dir_ / "fifo.ply";
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  test::ExpectInputError([&] { ReadPly(path); }, "fifo.ply", 0, "cannot open file (a FIFO");
 }
 
 TEST_F(PlyIoTest, MissingFileIsAnInputError) {

@@ -45,4 +45,10 @@ struct BlockGeometry {
 // Estimates the scene surface from the best source the block offers.
 BlockGeometry EstimateBlockGeometry(const Block& block);
 
+// Empty when some image has a surface estimate (and so a GSD). Otherwise one
+// line saying why none has, naming the block, the surface source and the
+// images: matching, merging and tiling all need a GSD, so commands fail with
+// this up front instead of with a zero radius after the work.
+std::string NoSurfaceReason(const Block& block, const BlockGeometry& geometry);
+
 }  // namespace sapmvs

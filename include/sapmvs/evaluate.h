@@ -32,6 +32,8 @@ struct GeoRaster;
 // centre, and a point anywhere between grid nodes still has at least 9; at the
 // paper's 4 points/m^2 (s = 0.5 m) it gives d = 1 m.
 constexpr double kRadiusPerSpacing = 2.0;
+// The largest --radius accepted, in LiDAR spacings (~8,000 points per query).
+constexpr double kMaxRadiusPerSpacing = 50.0;
 
 struct EvaluateOptions {
   // The dense cloud, by extension: .ply, .las, or .xyz / .txt (X Y Z lines).

@@ -22,7 +22,8 @@ ImageSize ReadImageSize(const std::filesystem::path& path);
 
 // Finds the image called `name` in `folder`: the exact file name first, then
 // a file whose stem is `name` (or `name`'s stem) with an image extension.
-// Returns an empty path when none is found.
+// Returns an empty path when none is found; throws sapmvs::Error naming both
+// files when two fit (a.jpg and a.png for `a`).
 std::filesystem::path FindImageFile(const std::filesystem::path& folder, const std::string& name);
 
 // True for the extensions the readers accept as images.
