@@ -102,7 +102,13 @@ bool RunCheckpoints::Done(int group) const {
   if (!std::filesystem::exists(StatusPath(group)) || !std::filesystem::exists(CloudPath(group))) {
     return false;
   }
-  return ReadJson(StatusPath(group)).value("status", "") == "done";
+  // A status left empty or cut (a full disk, before writes were checked)
+  // marks no finished group: it is matched again, not the resume refused.
+  try {
+    return ReadJson(StatusPath(group)).value("status", "") == "done";
+  } catch (const InputError&) {
+    return false;
+  }
 }
 
 GroupCheckpoint RunCheckpoints::Read(int group) const {

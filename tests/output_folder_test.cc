@@ -134,5 +134,16 @@ TEST_F(OutputFolderTest, FullDiskAtAJsonFileFailsNamingItAndKeepsTheOldOne) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 
+// A group status an earlier version committed empty on a full disk: that
+// group is matched again instead of every resume failing until --restart.
+TEST_F(OutputFolderTest, EmptyGroupStatusMarksTheGroupUnfinished) {
+  const RunCheckpoints checkpoints(dir_, Block(), GroupingPlan(), MatcherOptions(), false);
+  Spit(checkpoints.CloudPath(0), "ply");
+  Spit(checkpoints.StatusPath(0), "");
+  EXPECT_FALSE(checkpoints.Done(0));
+  Spit(checkpoints.StatusPath(0), "{\"status\": \"done\"}");
+  EXPECT_TRUE(checkpoints.Done(0));
+}
+
 }  // namespace
 }  // namespace sapmvs
