@@ -465,6 +465,30 @@ ClContext::ClContext(const DeviceInfo& device, bool profile)
   }
 }
 
+ClContext::~ClContext() { Release(); }
+
+ClContext& ClContext::operator=(ClContext&& other) noexcept {
+  if (this != &other) {
+    Release();
+    device_ = std::move(other.device_);
+    profiling_ = other.profiling_;
+    context_ = std::move(other.context_);
+    queue_ = std::move(other.queue_);
+    programs_ = std::move(other.programs_);
+  }
+  return *this;
+}
+
+void ClContext::Release() noexcept {
+  if (queue_) {
+    const cl_int status = clFinish(queue_.get());
+    if (status != CL_SUCCESS) internal::LogClFailure(status, "clFinish", __FILE__, __LINE__);
+  }
+  programs_.clear();
+  queue_.Reset();
+  context_.Reset();
+}
+
 const ClProgram& ClContext::Program(std::string_view kernel_file, const BuildOptions& defines) {
   return CachedProgram(kernel_file, defines, std::nullopt);
 }

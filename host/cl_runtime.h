@@ -349,6 +349,16 @@ class ClContext {
   // Selects a device as described in DeviceOptions. Throws NoDeviceError.
   explicit ClContext(const DeviceOptions& options = DeviceOptions());
   ClContext(const DeviceInfo& device, bool profile);
+  // Waits for the queue (Finish) before releasing the programs, the queue and
+  // the context, in that order. A command still in flight at release can
+  // leave a driver thread working (PoCL compiles a kernel's work-group
+  // function when it first runs) while the process exits and tears down the
+  // compiler under it.
+  ~ClContext();
+  ClContext(ClContext&& other) noexcept = default;
+  ClContext& operator=(ClContext&& other) noexcept;
+  ClContext(const ClContext&) = delete;
+  ClContext& operator=(const ClContext&) = delete;
 
   const DeviceInfo& device() const { return device_; }
   cl_device_id device_id() const { return device_.id; }
@@ -384,6 +394,8 @@ class ClContext {
   // `source` empty: load kernels/<name> on a cache miss.
   const ClProgram& CachedProgram(std::string_view name, const BuildOptions& defines,
                                  std::optional<std::string_view> source);
+  // Finish, then release in order; leaves the object empty. Never throws.
+  void Release() noexcept;
 
   DeviceInfo device_;
   bool profiling_ = false;

@@ -73,17 +73,12 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
       throw Error("plan: expected " + problem);
     const BlockReadOptions read = ReadOptionsOf(args->flags);
     // A JSON path in a missing folder fails here, before the block is read.
-    std::unique_ptr<AtomicFile> json;
-    if (!args->json.empty()) json = std::make_unique<AtomicFile>(args->json);
+    if (!args->json.empty()) AtomicFile check(args->json);
     const Block block = ReadBlock(args->block, read);
     const GroupingPlan plan = PlanGroups(block, args->grouping);
     PrintPlan(block, plan, std::cout);
-    if (json) {
-      std::ofstream out(json->temp_path());
-      out << PlanToJson(block, plan).dump(2) << "\n";
-      out.close();
-      if (!out) throw Error(args->json + ": cannot write");
-      json->Commit();
+    if (!args->json.empty()) {
+      WriteTextAtomically(args->json, PlanToJson(block, plan).dump(2) + "\n");
       std::cout << "plan written to " << args->json << "\n";
     }
   });

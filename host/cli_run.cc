@@ -8,9 +8,28 @@
 
 #include "cli.h"
 #include "run_profile.h"
+#include "sapmvs/atomic_file.h"
 #include "sapmvs/dense_run.h"
+#include "sapmvs/error.h"
 
 namespace sapmvs::cli {
+namespace {
+
+// The profile is written after the whole run: a folder that is not there
+// must fail before the matching, not after it. DIR itself is made by the run.
+void CheckProfilePath(const std::filesystem::path& csv, const std::filesystem::path& out) {
+  std::error_code ec;
+  const std::filesystem::path dir = csv.parent_path().empty() ? "." : csv.parent_path();
+  if (std::filesystem::weakly_canonical(dir, ec) == std::filesystem::weakly_canonical(out, ec))
+    return;
+  try {
+    AtomicFile check(csv);
+  } catch (const Error& e) {
+    throw Error(std::string("--profile ") + e.what());
+  }
+}
+
+}  // namespace
 
 void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   auto o = std::make_shared<RunOptions>();
@@ -122,6 +141,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
         o->matcher.mode = ParseMatchMode(*mode);
         o->matcher.use_edges = !*no_edges;
         o->matcher.progress = !global.quiet;
+        if (o->profile && !profile->empty()) CheckProfilePath(*profile, o->out);
         const RunReport report = RunDense(*o);
         PrintRunSummary(report, std::cout);
         if (o->profile) {

@@ -219,11 +219,9 @@ void WriteReliefPng(const std::filesystem::path& path, const GeoRaster& dsm) {
   }
   std::vector<uint8_t> bytes;
   if (!cv::imencode(".png", colour, bytes)) throw Error(path.string() + ": PNG encoding failed");
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
+  WriteStreamAtomically(path, [&](std::ostream& f) {
     f.write(reinterpret_cast<const char*>(bytes.data()),
             static_cast<std::streamsize>(bytes.size()));
-    if (!f) throw Error(path.string() + ": write failed");
   });
 }
 

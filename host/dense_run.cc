@@ -20,6 +20,7 @@
 #include "sapmvs/error.h"
 #include "sapmvs/las_io.h"
 #include "sapmvs/memory_use.h"
+#include "sapmvs/output_folder.h"
 #include "sapmvs/ply_io.h"
 #include "sapmvs/progress.h"
 #include "sapmvs/raster_io.h"
@@ -134,6 +135,10 @@ std::vector<PointRecord> ToLasRecords(const PointCloud& cloud) {
 RunReport RunDense(const RunOptions& options) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("run: expected " + problem);
+  // Everything that can be refused is checked before the first file is
+  // written, so a failed start leaves nothing that stops the corrected
+  // command: the folder, the block and its CRS, the device.
+  OutputFolder::Check(options.out, "run");
   const auto start = std::chrono::steady_clock::now();
   RunReport report;
   report.out = options.out;
@@ -144,6 +149,11 @@ RunReport RunDense(const RunOptions& options) {
   };
 
   const Block block = ReadBlock(options.block, options.read);
+  try {
+    CrsToWkt(block.crs);  // what cloud.las and dsm.tif will need, after all the matching
+  } catch (const Error& e) {
+    throw Error(block.source.string() + ": " + e.what());
+  }
   report.images = static_cast<int>(block.images.size());
   const BlockGeometry geometry = EstimateBlockGeometry(block);
   // Without a GSD the merge radius would be 0, found only after matching.
@@ -174,16 +184,15 @@ RunReport RunDense(const RunOptions& options) {
   }
   end_stage("plan");
 
-  std::error_code ec;
-  std::filesystem::create_directories(options.out, ec);
-  if (ec) throw Error(options.out.string() + ": cannot create the output folder: " + ec.message());
-  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher, options.restart);
-
   DeviceOptions device_options;
   device_options.device = options.device;
   device_options.profile = options.profile;
   ClContext context(device_options);
   report.device = context.device().Describe();
+
+  const OutputFolder folder(options.out, "run", {"groups"});
+  if (options.restart) RemoveRunOutputs(options.out);
+  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher, options.restart);
 
   const bool show = options.matcher.progress && Progress::TerminalAllowsProgress();
   const int n = static_cast<int>(plan.groups.size());

@@ -81,12 +81,9 @@ cv::Vec3b Diverging(double t) {
 void WritePng(const std::filesystem::path& path, const cv::Mat& img) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", img, bytes)) throw Error(path.string() + ": PNG encoding failed");
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
+  WriteStreamAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(bytes.data()),
               static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw Error(path.string() + ": write failed (disk full or I/O error)");
   });
 }
 

@@ -107,12 +107,7 @@ void WriteEvaluationJson(const EvaluationReport& r, const std::filesystem::path&
                          {"share", Number(r.completeness->share)}};
   }
   const std::string text = j.dump(2) + "\n";
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw Error(path.string() + ": write failed (disk full or I/O error)");
-  });
+  WriteStreamAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
 }  // namespace sapmvs

@@ -292,9 +292,7 @@ void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>&
   const std::vector<uint8_t> vlr = wkt.empty() ? std::vector<uint8_t>() : MakeWktVlr(path, wkt);
   const std::vector<uint8_t> header = MakeHeader(points, q, vlr.size(), options);
 
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path.string() + ": cannot create " + tmp.string());
+  WriteStreamAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(header.data()), header.size());
     out.write(reinterpret_cast<const char*>(vlr.data()), vlr.size());
     std::vector<uint8_t> buf(kChunkPoints * kWriteRecordLength);
@@ -306,8 +304,6 @@ void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>&
       out.write(reinterpret_cast<const char*>(buf.data()),
                 static_cast<std::streamsize>(n * kWriteRecordLength));
     }
-    out.close();
-    if (!out) throw Error(path.string() + ": write failed (disk full or I/O error)");
   });
 }
 
@@ -451,9 +447,7 @@ void WriteXyz(const std::filesystem::path& path, const std::vector<PointRecord>&
                 " (expected 0-17 decimals)");
   }
   CheckPoints(path, points);
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) throw Error(path.string() + ": cannot create " + tmp.string());
+  WriteStreamAtomically(path, [&](std::ostream& out) {
     char line[256];
     for (const PointRecord& p : points) {
       int n = std::snprintf(line, sizeof line, "%.*f %.*f %.*f", precision, p.x, precision, p.y,
@@ -469,8 +463,6 @@ void WriteXyz(const std::filesystem::path& path, const std::vector<PointRecord>&
       line[n] = '\n';
       out.write(line, n + 1);
     }
-    out.close();
-    if (!out) throw Error(path.string() + ": write failed (disk full or I/O error)");
   });
 }
 

@@ -526,9 +526,7 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud) {
   }
   header << "end_header\n";
 
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw Error(file + ": cannot open " + tmp.string() + " for writing");
+  WriteStreamAtomically(path, [&](std::ostream& out) {
     const std::string text = header.str();
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
     std::vector<uint8_t> buffer;
@@ -559,8 +557,6 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud) {
       out.write(reinterpret_cast<const char*>(buffer.data()),
                 static_cast<std::streamsize>(buffer.size()));
     }
-    out.close();
-    if (!out) throw Error(file + ": write failed (disk full?)");
   });
 }
 

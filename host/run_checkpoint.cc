@@ -33,14 +33,44 @@ nlohmann::json PlanRecord(const Block& block, const GroupingPlan& plan,
   return {{"groups", groups}, {"matcher", MatcherOptionsJson(matcher)}};
 }
 
+// group_NNN.ply or group_NNN.json, as CloudPath/StatusPath name them.
+bool IsGroupCheckpointName(const std::string& name) {
+  const size_t dot = name.rfind('.');
+  if (name.rfind("group_", 0) != 0 || dot == std::string::npos || dot < 9) return false;
+  const std::string digits = name.substr(6, dot - 6);
+  const std::string ext = name.substr(dot);
+  return digits.find_first_not_of("0123456789") == std::string::npos &&
+         (ext == ".ply" || ext == ".json");
+}
+
 }  // namespace
+
+void RemoveCheckpoints(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::remove(dir / "plan.json", ec);
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (IsGroupCheckpointName(it->path().filename().string())) {
+      std::error_code rm;
+      std::filesystem::remove(it->path(), rm);
+    }
+  }
+}
+
+void RemoveRunOutputs(const std::filesystem::path& out) {
+  std::error_code ec;
+  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm.tif.aux.xml", "dsm.png",
+                        "report.json", "profile.csv", "profile.json"}) {
+    std::filesystem::remove(out / f, ec);
+  }
+  RemoveCheckpoints(out / "groups");
+}
 
 RunCheckpoints::RunCheckpoints(std::filesystem::path dir, const Block& block,
                                const GroupingPlan& plan, const MatcherOptions& matcher,
                                bool restart)
     : dir_(std::move(dir)) {
   std::error_code ec;
-  if (restart) std::filesystem::remove_all(dir_, ec);
+  if (restart) RemoveCheckpoints(dir_);
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw Error(dir_.string() + ": cannot create the checkpoint folder: " + ec.message());
   const nlohmann::json record = PlanRecord(block, plan, matcher);
@@ -72,7 +102,13 @@ bool RunCheckpoints::Done(int group) const {
   if (!std::filesystem::exists(StatusPath(group)) || !std::filesystem::exists(CloudPath(group))) {
     return false;
   }
-  return ReadJson(StatusPath(group)).value("status", "") == "done";
+  // A status left empty or cut (a full disk, before writes were checked)
+  // marks no finished group: it is matched again, not the resume refused.
+  try {
+    return ReadJson(StatusPath(group)).value("status", "") == "done";
+  } catch (const InputError&) {
+    return false;
+  }
 }
 
 GroupCheckpoint RunCheckpoints::Read(int group) const {

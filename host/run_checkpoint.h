@@ -19,9 +19,17 @@ struct GroupCheckpoint {
   double seconds = 0;
 };
 
+// Removes what `sapmvs run` writes into `out` (cloud.ply, cloud.las, dsm.tif
+// and its side-car, dsm.png, report.json, profile.csv/json) and its
+// checkpoints in out/groups, by name: a user's other files there stay.
+void RemoveRunOutputs(const std::filesystem::path& out);
+// plan.json and group_NNN.ply/.json in `dir`, and nothing else.
+void RemoveCheckpoints(const std::filesystem::path& dir);
+
 class RunCheckpoints {
  public:
-  // Creates `dir`; with `restart` removes what an earlier run left there.
+  // Creates `dir`; with `restart` removes the checkpoints an earlier run left
+  // there (RemoveCheckpoints).
   // Throws Error naming plan.json when it records another plan or options.
   RunCheckpoints(std::filesystem::path dir, const Block& block, const GroupingPlan& plan,
                  const MatcherOptions& matcher, bool restart);

@@ -100,8 +100,7 @@ void PrintProfile(const RunReport& report, std::ostream& out) {
 void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
   const std::vector<KernelProfile> kernels = ProfileKernels(report.stats);
   const std::vector<PhaseProfile> phases = ProfilePhases(report);
-  WriteFileAtomically(csv, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp);
+  WriteStreamAtomically(csv, [&](std::ostream& f) {
     f << "kind,name,launches,items,ncc_evaluations,seconds,mean_ms,max_ms,items_per_s,"
          "ncc_evaluations_per_s,est_bytes,est_flops,gb_per_s,gflop_per_s,wall_s,device_s,host_s\n";
     f << std::setprecision(9);
@@ -115,7 +114,6 @@ void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
       f << "phase," << p.phase << ",,,,,,,,,,,,," << p.wall << "," << p.device << "," << p.host()
         << "\n";
     }
-    if (!f) throw Error(csv.string() + ": write failed");
   });
   nlohmann::json j;
   j["device"] = report.device;

@@ -9,11 +9,7 @@
 namespace sapmvs {
 
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
-  WriteFileAtomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream f(tmp);
-    f << std::setw(2) << j << "\n";
-    if (!f) throw Error(path.string() + ": write failed");
-  });
+  WriteStreamAtomically(path, [&](std::ostream& f) { f << std::setw(2) << j << "\n"; });
 }
 
 nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {

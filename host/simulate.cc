@@ -11,6 +11,7 @@
 #include "sapmvs/camera.h"
 #include "sapmvs/error.h"
 #include "sapmvs/las_io.h"
+#include "sapmvs/output_folder.h"
 #include "sapmvs/progress.h"
 #include "sapmvs/raster_io.h"
 #include "sim_lidar.h"
@@ -68,23 +69,12 @@ cv::Mat Render(const sim::Scene& scene, const Camera& cam, const SimulateOptions
   return img;
 }
 
-void WriteText(const fs::path& path, const std::string& text) {
-  WriteFileAtomically(path, [&](const fs::path& tmp) {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw Error(path.string() + ": cannot write");
-  });
-}
+void WriteText(const fs::path& path, const std::string& text) { WriteTextAtomically(path, text); }
 
 void WritePng(const fs::path& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", image, bytes)) throw Error(path.string() + ": PNG encoding failed");
-  WriteFileAtomically(path, [&](const fs::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw Error(path.string() + ": cannot write");
-  });
+  WriteBytesAtomically(path, bytes.data(), bytes.size());
 }
 
 std::string Fixed(double v, int precision) {
@@ -193,6 +183,10 @@ SimulatedWorld BuildWorld(const SimulateOptions& o) {
 }
 
 SimulateSummary Simulate(const SimulateOptions& o) {
+  if (const std::string problem = o.Problem(); !problem.empty())
+    throw Error("simulate: " + problem);
+  // Claimed before the scene is built: a user's folder is refused at once.
+  const OutputFolder folder(o.out, "simulate", {"images", "truth"});
   const sim::Preset preset = sim::FindPreset(o.preset);
   SimulateSummary summary;
   summary.order = o.angles.empty() ? preset.order : ParseAngleOrder(o.angles);

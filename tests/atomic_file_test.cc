@@ -1,6 +1,7 @@
 #include "sapmvs/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "file_size_limit.h"
 #include "sapmvs/error.h"
 #include "test_util.h"
 
@@ -134,6 +136,79 @@ TEST_F(AtomicFileTest, WriteBytesAndTextReplaceTheFileWhole) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
   }
+}
+
+// The writers' bug: the data sat in the stream's buffer, the check ran before
+// the flush, and a full disk committed a 0-byte file. Here the whole text
+// fits the buffer, so only the flush at the end can fail.
+TEST_F(AtomicFileTest, FullDiskAtTheFinalFlushFailsNamingTheFileAndKeepsTheOldOne) {
+  const fs::path path = dir_ / "report.json";
+  Spit(path, "old");
+  std::string what;
+  {
+    test::FileSizeLimit limit(100);
+    if (!limit.ok()) GTEST_SKIP() << "cannot set RLIMIT_FSIZE";
+    try {
+      WriteStreamAtomically(path, [](std::ostream& out) {
+        for (int i = 0; i < 100; ++i) out << "{\"line\": " << i << "}\n";
+      });
+    } catch (const Error& e) {
+      what = e.what();
+    }
+  }
+  EXPECT_EQ(what, path.string() + ": write failed: File too large");
+  EXPECT_EQ(Slurp(path), "old");
+  EXPECT_EQ(FileCount(), 1);  // no temporary file
+}
+
+TEST_F(AtomicFileTest, FullDiskInALargeWriteFailsNamingTheFile) {
+  const fs::path path = dir_ / "cloud.ply";
+  const std::string big(1 << 20, 'x');  // larger than the stream's buffer
+  std::string what;
+  {
+    test::FileSizeLimit limit(4096);
+    if (!limit.ok()) GTEST_SKIP() << "cannot set RLIMIT_FSIZE";
+    try {
+      WriteBytesAtomically(path, big.data(), big.size());
+    } catch (const Error& e) {
+      what = e.what();
+    }
+  }
+  EXPECT_EQ(what, path.string() + ": write failed: File too large");
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_EQ(FileCount(), 0);
+}
+
+TEST_F(AtomicFileTest, TempNamesAreRecognisedWithTheirWritersPid) {
+  long pid = 0;
+  EXPECT_TRUE(IsAtomicTempName(".cloud.ply.tmp.1234.7", &pid));
+  EXPECT_EQ(pid, 1234);
+  EXPECT_TRUE(IsAtomicTempName(".dsm.tif.tmp.99.0.aux.xml", &pid));
+  EXPECT_EQ(pid, 99);
+  for (const char* name : {"cloud.ply.tmp.1.2", ".cloud.ply", ".x.tmp.1", ".x.tmp..2", ".x.tmp.a.2",
+                           ".x.tmp.1.2b", ".tmp.1.2", "notes.txt"}) {
+    EXPECT_FALSE(IsAtomicTempName(name)) << name;
+  }
+}
+
+// A writer killed during a write leaves its hidden temporary file; the next
+// command on the folder removes it, but not one a live process still writes,
+// nor anything that is not an AtomicFile's.
+TEST_F(AtomicFileTest, StaleTempFilesOfDeadWritersAreRemoved) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // now no such process
+  const std::string dead = std::to_string(child), live = std::to_string(::getppid());
+  const std::vector<std::string> stale = {".cloud.ply.tmp." + dead + ".3",
+                                          ".dsm.tif.tmp." + dead + ".0.aux.xml"};
+  const std::vector<std::string> kept = {".cloud.las.tmp." + live + ".1", "cloud.ply", ".hidden",
+                                         "notes.tmp." + dead + ".1"};
+  for (const auto& f : stale) Spit(dir_ / f, "partial");
+  for (const auto& f : kept) Spit(dir_ / f, "keep");
+  EXPECT_EQ(RemoveStaleTempFiles(dir_), 2);
+  for (const auto& f : stale) EXPECT_FALSE(fs::exists(dir_ / f)) << f;
+  for (const auto& f : kept) EXPECT_TRUE(fs::exists(dir_ / f)) << f;
 }
 
 }  // namespace

@@ -381,5 +381,28 @@ TEST_F(ClRuntimeTest, EventTimingNeedsProfilingQueue) {
   EXPECT_NE(what.find("DeviceOptions::profile"), std::string::npos) << what;
 }
 
+// A context released with a command still queued must wait for it: PoCL
+// compiles a kernel's work-group function when it first runs, and a driver
+// thread still compiling while the process exits crashed it at exit.
+TEST_F(ClRuntimeTest, ReleasedContextHasFinishedItsQueue) {
+  ClEvent event;
+  {
+    ClContext scoped(context().device(), /*profile=*/false);
+    // A local size no other test uses, so the launch compiles a work-group
+    // function of its own.
+    ClKernel kernel =
+        scoped.ProgramFromSource("iota_release_test", kIotaSource, {{"SCALE", "3"}}).Kernel("iota");
+    ClBuffer out(scoped, 48 * sizeof(cl_int));
+    ClBuffer launched(scoped, sizeof(cl_int));
+    kernel.SetArgs(out, cl_int{48}, launched);
+    event = scoped.Enqueue(kernel, 48, 3);
+  }
+  cl_int status = CL_QUEUED;
+  ASSERT_EQ(clGetEventInfo(event.get(), CL_EVENT_COMMAND_EXECUTION_STATUS, sizeof(status), &status,
+                           nullptr),
+            CL_SUCCESS);
+  EXPECT_EQ(status, CL_COMPLETE);
+}
+
 }  // namespace
 }  // namespace sapmvs

@@ -59,6 +59,8 @@ inline DeviceOptions TestDeviceOptions(const std::vector<DeviceInfo>& devices) {
   return options;  // Default device.
 }
 
+class ClReleaseEnvironment;
+
 class ClTest : public ::testing::Test {
  protected:
   struct Shared {
@@ -76,14 +78,26 @@ class ClTest : public ::testing::Test {
   ClContext& context() { return *GetShared().context; }
 
   // One context per test process, so programs are built once per process.
-  // Deliberately leaked: releasing OpenCL objects during static destruction
-  // can race the driver's own teardown.
+  // Released by ClReleaseEnvironment when the tests are done, before static
+  // destruction: released (or leaked) later, a command still in flight can
+  // keep a driver thread compiling while the process tears down under it.
   static Shared& GetShared() {
-    static Shared* shared = new Shared(CreateShared());
-    return *shared;
+    if (!shared_) shared_ = new Shared(CreateShared());
+    return *shared_;
+  }
+
+  // Finishes the shared context's queue and releases it; the next GetShared()
+  // would make a new one.
+  static void ReleaseShared() {
+    if (!shared_) return;
+    delete shared_;  // ~ClContext waits for the queue first
+    shared_ = nullptr;
   }
 
  private:
+  friend class ClReleaseEnvironment;
+  static inline Shared* shared_ = nullptr;
+
   static Shared CreateShared() {
     Shared shared;
     std::vector<DeviceInfo> devices;
@@ -104,5 +118,14 @@ class ClTest : public ::testing::Test {
     return shared;
   }
 };
+
+// Registered once per test binary, before main: its TearDown runs after the
+// last test and before exit.
+class ClReleaseEnvironment : public ::testing::Environment {
+ public:
+  void TearDown() override { ClTest::ReleaseShared(); }
+};
+inline ::testing::Environment* const kClReleaseEnvironment =
+    ::testing::AddGlobalTestEnvironment(new ClReleaseEnvironment);
 
 }  // namespace sapmvs::test

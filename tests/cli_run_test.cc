@@ -113,7 +113,8 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
   for (const auto& e : fs::recursive_directory_iterator(out_)) {
     if (e.is_regular_file()) files.insert(fs::relative(e.path(), out_).string());
   }
-  const std::set<std::string> expected = {"cloud.ply",
+  const std::set<std::string> expected = {".sapmvs_run",  // the folder's marker and lock
+                                          "cloud.ply",
                                           "cloud.las",
                                           "dsm.tif",
                                           "dsm.png",

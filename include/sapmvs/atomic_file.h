@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <ostream>
 #include <string>
 
 namespace sapmvs {
@@ -29,9 +30,11 @@ class AtomicFile {
   // unique per process and object, so concurrent writers do not collide.
   const std::filesystem::path& temp_path() const { return temp_path_; }
 
-  // Renames the temporary file onto the destination, replacing any file
-  // there. Throws sapmvs::Error naming the destination when the temporary
-  // file is missing or the rename fails; the destination is then untouched.
+  // Flushes the temporary file to the disk (fsync), renames it onto the
+  // destination, replacing any file there, and syncs the directory: after a
+  // crash the name holds the old file or the whole new one, never an empty
+  // one. Throws sapmvs::Error naming the destination when the temporary file
+  // is missing or a step fails; the destination is then untouched.
   void Commit();
   bool committed() const { return committed_; }
 
@@ -46,11 +49,26 @@ class AtomicFile {
 void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(const std::filesystem::path& tmp)>& write);
 
-// Writes `size` bytes (an encoded image, a text) to `path` atomically, flushed
-// to the disk (fsync) before the rename: after a crash the name then holds the
-// old file or the whole new one, never an empty one. Throws sapmvs::Error
-// naming `path`.
+// Calls `write(out)` to fill a temporary file through a stream that checks
+// every write, then flushes, fsyncs, closes (checked) and commits it onto
+// `path`. The first failed write, flush, fsync or close throws sapmvs::Error
+// "PATH: write failed: REASON" (e.g. "No space left on device"), and neither
+// a temporary file nor a changed `path` is left. A writer that stops early
+// because the stream went bad needs no check of its own.
+void WriteStreamAtomically(const std::filesystem::path& path,
+                           const std::function<void(std::ostream& out)>& write);
+
+// Writes `size` bytes (an encoded image, a text) to `path` the same way.
 void WriteBytesAtomically(const std::filesystem::path& path, const void* data, std::size_t size);
 void WriteTextAtomically(const std::filesystem::path& path, const std::string& text);
+
+// True for the name of a temporary file AtomicFile makes (`.NAME.tmp.PID.N`,
+// or GDAL's `.aux.xml` side-car of one); sets `*pid` to the writer's pid.
+bool IsAtomicTempName(const std::string& filename, long* pid = nullptr);
+
+// Removes the temporary files in `dir` (not below it) left by writers that
+// no longer run (killed during a write); returns how many. Those of a live
+// process, which may still be writing, stay.
+int RemoveStaleTempFiles(const std::filesystem::path& dir);
 
 }  // namespace sapmvs
