@@ -8,8 +8,10 @@
 // (export_frame.h), at the project's root, puts it back into the world frame.
 
 #include <Eigen/Geometry>
+#include <iostream>
 #include <map>
 
+#include "colmap_camera.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/export_frame.h"
@@ -18,40 +20,19 @@
 
 namespace sapmvs {
 namespace fs = std::filesystem;
-namespace {
 
-struct ColmapModel {
-  const char* name;
-  int num_params;
-  const char* layout;
-};
+const std::vector<ColmapModel>& ColmapModels() {
+  static const std::vector<ColmapModel> models = {
+      {"SIMPLE_PINHOLE", 3, "f cx cy"},         {"PINHOLE", 4, "fx fy cx cy"},
+      {"SIMPLE_RADIAL", 4, "f cx cy k"},        {"RADIAL", 5, "f cx cy k1 k2"},
+      {"OPENCV", 8, "fx fy cx cy k1 k2 p1 p2"},
+  };
+  return models;
+}
 
-constexpr ColmapModel kModels[] = {
-    {"SIMPLE_PINHOLE", 3, "f cx cy"},         {"PINHOLE", 4, "fx fy cx cy"},
-    {"SIMPLE_RADIAL", 4, "f cx cy k"},        {"RADIAL", 5, "f cx cy k1 k2"},
-    {"OPENCV", 8, "fx fy cx cy k1 k2 p1 p2"},
-};
-
-Intrinsics ParseCamera(const TextLines& lines, const std::vector<std::string>& t) {
-  lines.ExpectCount(t, 4, "CAMERA_ID MODEL WIDTH HEIGHT PARAMS...", true);
-  const ColmapModel* model = nullptr;
-  for (const ColmapModel& m : kModels) {
-    if (t[1] == m.name) model = &m;
-  }
-  if (!model) {
-    throw lines.Fail("unsupported camera model '" + t[1] +
-                     "': expected SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV");
-  }
-  const std::string layout =
-      std::string("CAMERA_ID ") + model->name + " WIDTH HEIGHT " + model->layout;
-  lines.ExpectCount(t, 4 + model->num_params, layout);
-  const int w = lines.Int(t[2], "WIDTH"), h = lines.Int(t[3], "HEIGHT");
-  if (w <= 0 || h <= 0) throw lines.Fail("expected a positive WIDTH and HEIGHT");
-  std::vector<double> p;
-  for (int i = 0; i < model->num_params; ++i)
-    p.push_back(lines.Double(t[4 + i], "camera parameter " + std::to_string(i + 1)));
+Intrinsics ColmapIntrinsics(const ColmapModel& model, int w, int h, const std::vector<double>& p) {
   Intrinsics k;
-  const std::string m = model->name;
+  const std::string m = model.name;
   if (m == "PINHOLE" || m == "OPENCV") {
     k = Intrinsics::FromPixels(p[0], p[1], p[2] - 0.5, p[3] - 0.5, w, h);
   } else {
@@ -68,6 +49,30 @@ Intrinsics ParseCamera(const TextLines& lines, const std::vector<std::string>& t
     k.distortion.p1 = p[6];
     k.distortion.p2 = p[7];
   }
+  return k;
+}
+
+namespace {
+
+Intrinsics ParseCamera(const TextLines& lines, const std::vector<std::string>& t) {
+  lines.ExpectCount(t, 4, "CAMERA_ID MODEL WIDTH HEIGHT PARAMS...", true);
+  const ColmapModel* model = nullptr;
+  for (const ColmapModel& m : ColmapModels()) {
+    if (t[1] == m.name) model = &m;
+  }
+  if (!model) {
+    throw lines.Fail("unsupported camera model '" + t[1] +
+                     "': expected SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL or OPENCV");
+  }
+  const std::string layout =
+      std::string("CAMERA_ID ") + model->name + " WIDTH HEIGHT " + model->layout;
+  lines.ExpectCount(t, 4 + model->num_params, layout);
+  const int w = lines.Int(t[2], "WIDTH"), h = lines.Int(t[3], "HEIGHT");
+  if (w <= 0 || h <= 0) throw lines.Fail("expected a positive WIDTH and HEIGHT");
+  std::vector<double> p;
+  for (int i = 0; i < model->num_params; ++i)
+    p.push_back(lines.Double(t[4 + i], "camera parameter " + std::to_string(i + 1)));
+  const Intrinsics k = ColmapIntrinsics(*model, w, h, p);
   if (!(k.fx > 0 && k.fy > 0)) throw lines.Fail("expected a positive focal length");
   return k;
 }
@@ -75,9 +80,25 @@ Intrinsics ParseCamera(const TextLines& lines, const std::vector<std::string>& t
 fs::path ModelDir(const fs::path& given) {
   if (fs::is_regular_file(given)) return given.parent_path();
   for (const fs::path& dir : {given, given / "sparse", given / "sparse" / "0"}) {
-    if (fs::is_regular_file(dir / "cameras.txt")) return dir;
+    if (fs::is_regular_file(dir / "cameras.txt") || fs::is_regular_file(dir / "cameras.bin"))
+      return dir;
   }
   return given;
+}
+
+// COLMAP writes the binary model by default and the text one on export; when
+// a folder has both, the binary one is read (it is what COLMAP itself loads)
+// and a note says so. A file given by name chooses its own kind.
+bool UseBinaryModel(const fs::path& given, const fs::path& dir) {
+  if (fs::is_regular_file(given)) return given.extension() == ".bin";
+  const bool bin =
+      fs::is_regular_file(dir / "cameras.bin") && fs::is_regular_file(dir / "images.bin");
+  if (bin && fs::is_regular_file(dir / "cameras.txt")) {
+    std::cerr << "note: " << dir.string()
+              << " has both a binary (.bin) and a text (.txt) COLMAP model; reading the binary "
+                 "one\n";
+  }
+  return bin;
 }
 
 // The export's root holds sparse/0 (or is the model folder itself).
@@ -101,8 +122,9 @@ Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
   const fs::path export_root = ExportRoot(dir);
   const std::optional<ExportFrame> frame =
       export_root.empty() ? std::nullopt : ReadExportFrame(export_root);
+  const bool binary = UseBinaryModel(given, dir);
   std::map<int, Intrinsics> cameras;
-  {
+  if (!binary) {
     TextLines lines(dir / "cameras.txt");
     std::vector<std::string> t;
     while (lines.Next(&t)) {
@@ -111,7 +133,7 @@ Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
       cameras[id] = ParseCamera(lines, t);
     }
   }
-  if (cameras.empty()) throw InputError((dir / "cameras.txt").string(), 0, "no cameras");
+  if (!binary && cameras.empty()) throw InputError((dir / "cameras.txt").string(), 0, "no cameras");
 
   fs::path image_dir = options.image_dir;
   if (image_dir.empty()) {
@@ -127,6 +149,11 @@ Block ReadColmapBlock(const fs::path& given, const BlockReadOptions& options) {
   }
 
   Block block;
+  if (binary) {
+    block = ReadColmapBinaryModel(dir, image_dir);
+    if (frame) ApplyExportFrame(*frame, export_root, "colmap", &block);
+    return block;
+  }
   block.frame_note = "COLMAP model frame";
   TextLines lines(dir / "images.txt");
   std::string line;

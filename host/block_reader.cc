@@ -93,10 +93,13 @@ BlockFormat DetectBlockFormat(const fs::path& path) {
     if (ext == ".yaml" || ext == ".yml") return BlockFormat::kYaml;
     if (ext == ".json") return BlockFormat::kOpenSfm;
     if (ext == ".camera") return BlockFormat::kStrecha;
-    if (name == "cameras.txt" || name == "images.txt") return BlockFormat::kColmap;
+    if (name == "cameras.txt" || name == "images.txt" || name == "cameras.bin" ||
+        name == "images.bin") {
+      return BlockFormat::kColmap;
+    }
     throw Error(path.string() +
                 ": unknown block file (expected a .yaml block, an OpenSfM .json, a Strecha "
-                ".camera, or COLMAP cameras.txt/images.txt; or give --format)");
+                ".camera, or COLMAP cameras.txt/images.txt or .bin; or give --format)");
   }
   if (fs::is_regular_file(path / "block.yaml")) return BlockFormat::kYaml;
   if (fs::is_regular_file(path / "reconstruction.json") ||
@@ -104,8 +107,10 @@ BlockFormat DetectBlockFormat(const fs::path& path) {
     return BlockFormat::kOpenSfm;
   }
   for (const fs::path& sub : {fs::path(), fs::path("sparse"), fs::path("sparse") / "0"}) {
-    if (fs::is_regular_file(path / sub / "cameras.txt") &&
-        fs::is_regular_file(path / sub / "images.txt")) {
+    if ((fs::is_regular_file(path / sub / "cameras.txt") &&
+         fs::is_regular_file(path / sub / "images.txt")) ||
+        (fs::is_regular_file(path / sub / "cameras.bin") &&
+         fs::is_regular_file(path / sub / "images.bin"))) {
       return BlockFormat::kColmap;
     }
   }
@@ -115,7 +120,7 @@ BlockFormat DetectBlockFormat(const fs::path& path) {
   }
   throw Error(path.string() +
               ": no block found in folder (looked for block.yaml, reconstruction.json, "
-              "cameras.txt + images.txt, txt/NNNNNNNN.txt, *.camera; or give --format)");
+              "cameras.txt + images.txt (or .bin), txt/NNNNNNNN.txt, *.camera; or give --format)");
 }
 
 Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {

@@ -3,7 +3,9 @@
 // folder) unless BlockReadOptions::format names it.
 //   yaml     native block.yaml (see docs in README.md, "Block files")
 //   pmvs     PMVS/CMVS folder: txt/NNNNNNNN.txt (CONTOUR + 3x4 P), visualize/
-//   colmap   COLMAP text model: cameras.txt, images.txt (+ points3D.txt)
+//   colmap   COLMAP model, binary (cameras.bin, images.bin + points3D.bin) or
+//            text (cameras.txt, images.txt + points3D.txt); binary when a
+//            folder has both, with a note on stderr
 //   strecha  Strecha .camera files (K, distortion, R camera-to-world, C, W H)
 //   opensfm  OpenSfM reconstruction.json (perspective, brown)
 
