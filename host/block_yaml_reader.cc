@@ -44,6 +44,8 @@ class YamlFile {
 
   YAML::Node Required(const YAML::Node& map, const std::string& key,
                       const std::string& where) const {
+    // Subscripting a scalar throws yaml-cpp's own exception, not ours.
+    if (!map.IsMap()) Fail(map, "expected a mapping for " + where + " (with '" + key + "')");
     YAML::Node n = map[key];
     if (!n.IsDefined() || n.IsNull()) {
       throw InputError(path_, map.Mark().line + 1, "missing key '" + key + "' in " + where);
@@ -203,8 +205,9 @@ Block ReadYamlBlock(const fs::path& given, const BlockReadOptions& options) {
   std::map<std::string, Intrinsics> cameras;
   std::string single_camera;
   if (root["camera"]) {
-    single_camera =
-        root["camera"]["name"] ? f.As<std::string>(root["camera"]["name"], "a name") : "camera";
+    single_camera = root["camera"].IsMap() && root["camera"]["name"]
+                        ? f.As<std::string>(root["camera"]["name"], "a name")
+                        : "camera";
     cameras[single_camera] = ReadCamera(f, root["camera"]);
   } else if (root["cameras"] && root["cameras"].IsSequence()) {
     for (const auto& c : root["cameras"]) {

@@ -68,6 +68,7 @@ std::string Num(double v) {
 }
 
 std::string FixedString(const uint8_t* p, size_t n) {
+  if (n == 0) return {};  // an empty record's data() may be null
   return std::string(reinterpret_cast<const char*>(p),
                      strnlen(reinterpret_cast<const char*>(p), n));
 }

@@ -255,7 +255,7 @@ class BinaryCursor {
  private:
   bool Refill(size_t n) {
     const size_t keep = end_ - pos_;
-    std::memmove(buffer_.data(), buffer_.data() + pos_, keep);
+    if (keep > 0) std::memmove(buffer_.data(), buffer_.data() + pos_, keep);  // data() may be null
     if (buffer_.size() < std::max(n, kReadBufferSize)) buffer_.resize(std::max(n, kReadBufferSize));
     in_.read(reinterpret_cast<char*>(buffer_.data() + keep),
              static_cast<std::streamsize>(buffer_.size() - keep));
