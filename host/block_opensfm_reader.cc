@@ -142,9 +142,11 @@ Intrinsics ReadCamera(const JsonFile& f, const std::string& id, const json& c) {
   if (c.contains("projection_type") && !c["projection_type"].is_string())
     f.Fail(id, where + "/projection_type", "expected a string");
   const std::string type = c.value("projection_type", "");
-  const int w = static_cast<int>(f.Number(c, "width", where, id));
-  const int h = static_cast<int>(f.Number(c, "height", where, id));
-  if (w <= 0 || h <= 0) f.Fail(id, where, "expected a positive width and height");
+  const double wd = f.Number(c, "width", where, id), hd = f.Number(c, "height", where, id);
+  // Checked before the cast: a double past int's range converts with UB.
+  if (!(wd >= 1 && hd >= 1 && wd <= 1 << 20 && hd <= 1 << 20))
+    f.Fail(id, where, "expected a width and height of 1 to 1048576 px");
+  const int w = static_cast<int>(wd), h = static_cast<int>(hd);
   const double size = std::max(w, h);
   Intrinsics k;
   if (type == "perspective") {

@@ -106,10 +106,13 @@ std::filesystem::path FindImageFile(const std::filesystem::path& folder, const s
   namespace fs = std::filesystem;
   // Not only regular files: a FIFO or a link to nothing is found here and
   // refused by name where it is opened, instead of reported as missing.
-  if (fs::exists(fs::symlink_status(folder / name)) && !fs::is_directory(folder / name)) {
+  // A name from a file can be anything (longer than NAME_MAX, say): an
+  // error looking it up means "not found", not an exception.
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(folder / name, ec)) && !fs::is_directory(folder / name, ec)) {
     return folder / name;
   }
-  if (!fs::is_directory(folder)) return {};
+  if (!fs::is_directory(folder, ec)) return {};
   const std::string stem = fs::path(name).stem().string();
   std::vector<fs::path> hits;
   for (const auto& entry : fs::directory_iterator(folder)) {

@@ -110,5 +110,29 @@ TEST(ReaderFuzzRegression, OpenSfmNumberPastDoubleRange) {
       "reconstruction.json");
 }
 
+// A width past int's range was cast to int (undefined behaviour).
+TEST(ReaderFuzzRegression, OpenSfmHugeWidth) {
+  const fs::path dir = test::ScratchDir();
+  fs::create_directories(dir / "images");
+  std::ofstream(dir / "reconstruction.json")
+      << R"([{"cameras": {"c": {"projection_type": "perspective", "width": 1.4e16,)"
+      << R"( "height": 6, "focal": 1}}, "shots": {}}])";
+  ExpectInputErrorFor(
+      [&] { ReadBlock(dir / "reconstruction.json", NoSizeCheck(BlockFormat::kOpenSfm)); },
+      "reconstruction.json", "expected a width and height of 1 to 1048576 px");
+}
+
+// An image name longer than a file name may be made std::filesystem throw
+// its own filesystem_error (ENAMETOOLONG) while looking the image up.
+TEST(ReaderFuzzRegression, ColmapImageNameLongerThanAFileName) {
+  const fs::path dir = test::ScratchDir();
+  fs::create_directories(dir / "images");
+  const std::string name(300, 'x');
+  std::ofstream(dir / "cameras.txt") << "1 PINHOLE 640 480 500 500 320 240\n";
+  std::ofstream(dir / "images.txt") << "1 1 0 0 0 0 0 0 1 " << name << "\n\n";
+  ExpectInputErrorFor([&] { ReadBlock(dir, NoSizeCheck(BlockFormat::kColmap)); }, "images.txt",
+                      "no image '" + name + "'");
+}
+
 }  // namespace
 }  // namespace sapmvs
