@@ -4,32 +4,36 @@
 # build/fuzz, seeds each corpus from the shared data sets, tests/blocks and
 # sapmvs's own writers, and runs the targets one at a time for N executions.
 #
-#   scripts/fuzz.sh [--runs N] [--max-len BYTES] [--lanes L] [target...]
+#   scripts/fuzz.sh [--runs N] [--max-time S] [--max-len BYTES] [--lanes L] [target...]
 #
 # Targets: block_yaml block_pmvs colmap_text colmap_binary block_strecha
 # block_opensfm ply las (all by default). The corpora grow in
 # build/fuzz/corpus/TARGET across runs; a finding is saved as
 # build/fuzz/artifacts/TARGET-crash-* (replay: build/fuzz/tests/fuzz/fuzz_TARGET FILE)
-# and the script exits 1. Not a CI step: 1 M runs of all targets take about
-# an hour on two cores. Runs under `nice`, one target at a time (--lanes L:
-# L at a time). The inputs' files go to $TMPDIR (default /dev/shm: on a disk,
-# truncating files costs more than the readers). ASan keeps no allocation
-# stacks (malloc_context_size=0, a third faster); replay a finding without
-# it to see them.
+# and the script exits 1. Not a CI step: 1 M runs of one target take 5 to 15
+# minutes on an idle core (the block readers are the slow ones), far longer
+# on a busy machine; --max-time S stops each target after S seconds instead
+# (the summary says how many executions that was). Runs under `nice`, one
+# target at a time (--lanes L: L at a time). The inputs' files go to $TMPDIR
+# (default /dev/shm: on a disk, truncating files costs more than the
+# readers). ASan keeps no allocation stacks (malloc_context_size=0, a third
+# faster); replay a finding without it to see them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 runs=1000000
 max_len=16384
 lanes=1
+max_time=0
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --runs) runs="$2"; shift 2 ;;
     --max-len) max_len="$2"; shift 2 ;;
     --lanes) lanes="$2"; shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
-    -*) echo "fuzz.sh: unknown option $1 (expected --runs N, --max-len BYTES, --lanes L)" >&2; exit 1 ;;
+    --max-time) max_time="$2"; shift 2 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+    -*) echo "fuzz.sh: unknown option $1 (expected --runs N, --max-time S, --max-len BYTES, --lanes L)" >&2; exit 1 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
@@ -111,7 +115,7 @@ fuzz_one() {  # fuzz_one TARGET: appends its line to the summary; status 1 on a 
   start=$(date +%s)
   echo "fuzz.sh: $t: $runs runs (log $log)"
   set +e
-  nice "$build/tests/fuzz/fuzz_$t" -runs="$runs" -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 \
+  nice "$build/tests/fuzz/fuzz_$t" -runs="$runs" -max_total_time="$max_time" -max_len="$max_len" -timeout=20 -rss_limit_mb=2560 \
     -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" "$corpus" "$seeds/$t" >"$log" 2>&1
   rc=$?
   set -e
