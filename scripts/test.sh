@@ -1,8 +1,40 @@
 #!/usr/bin/env bash
 # Installs, builds and runs the whole test suite (GoogleTest through CTest;
 # OpenCL kernels run on the PoCL CPU device).
+#
+#   scripts/test.sh [ctest args...]              the full suite, in build/
+#   scripts/test.sh --sanitize [ctest args...]   AddressSanitizer + UBSan build
+#       in build-sanitize/ (gcc, -O1) of the tests that need no OpenCL device
+#       (label `host`, see tests/CMakeLists.txt); any report fails its test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
 jobs=$(nproc 2>/dev/null || echo 2)
+if [ "${1:-}" = "--sanitize" ]; then
+  shift
+  bash scripts/install-deps.sh
+  build=build-sanitize
+  start=$(date +%s)
+  if [ ! -f "$build/CMakeCache.txt" ]; then
+    launcher=()
+    command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    # -O1 and line tables only: the quickest build whose reports still have
+    # file:line stacks. No NDEBUG, so that assertions are checked too. gcc,
+    # because clang 14 rejects a C++20 lambda capture the code uses;
+    # float-cast-overflow is not part of gcc's -fsanitize=undefined.
+    san="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
+    cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_COMPILER=g++ \
+      -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1 -fno-omit-frame-pointer $san" \
+      -DCMAKE_EXE_LINKER_FLAGS_SANITIZE="-fsanitize=address,undefined,float-cast-overflow" \
+      -DSAPMVS_BUILD_BENCHMARKS=OFF -DSAPMVS_TESTS_HOST_ONLY=ON "${launcher[@]}" >/dev/null
+  fi
+  cmake --build "$build" --target sapmvs_tests -j"$jobs"
+  built=$(date +%s)
+  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
+  export LSAN_OPTIONS="suppressions=$PWD/tests/sanitize/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+  ctest --test-dir "$build" --output-on-failure -L host -j"$jobs" "$@"
+  echo "test.sh --sanitize: build $((built - start)) s, tests $(($(date +%s) - built)) s"
+  exit 0
+fi
+bash scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$jobs" "$@"
