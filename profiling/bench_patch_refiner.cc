@@ -3,7 +3,8 @@
 // refined against its three views, starting a quarter of a footprint off the
 // plane and with its normal tilted 10 degrees, as propagation candidates
 // start. "patches/s" counts refined patches; "ncc_evals/s" the (1 + 6 x
-// iterations) x views NCC evaluations each patch's search scores at most.
+// iterations) x views NCC evaluations each patch's search scores at most
+// (an early stop after max_halvings scores fewer).
 //   SAPMVS_DEVICE=pocl ./build/profiling/bench_patch_refiner --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
@@ -56,6 +57,7 @@ void BM_RefineKernelDeviceTime(benchmark::State& state) {
   }
   PatchRefinerOptions o;
   o.patch_size = static_cast<int>(state.range(1));
+  o.max_halvings = static_cast<int>(state.range(2));
   const RefineBatch r = MakeRefineBatch(static_cast<int>(state.range(0)));
   PatchRefiner refiner(*shared.context, o);
   refiner.SetGroup(r.batch.group);
@@ -81,8 +83,10 @@ void BM_RefineReference(benchmark::State& state) {
   SetRates(state, r, o);
 }
 
+// Third argument: max_halvings, the default against never stopping early
+// (kMaxRefineIterations), to show what the early stop saves on a device.
 BENCHMARK(BM_RefineKernelDeviceTime)
-    ->ArgsProduct({{2000}, {7, 21}})
+    ->ArgsProduct({{2000}, {7, 21}, {kDefaultRefineHalvings, kMaxRefineIterations}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RefineReference)
