@@ -10,15 +10,8 @@
 namespace sapmvs {
 namespace {
 
+using test::HaveOpenClDevice;
 using test::RunCli;
-
-bool HaveOpenClDevice() {
-  try {
-    return !ListDevices().empty();
-  } catch (const Error&) {
-    return false;
-  }
-}
 
 TEST(CliDevices, ListsDevicesAndMarksTheDefault) {
   if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";

@@ -23,15 +23,8 @@ namespace sapmvs {
 namespace {
 
 namespace fs = std::filesystem;
+using test::HaveOpenClDevice;
 using test::RunCli;
-
-bool HaveOpenClDevice() {
-  try {
-    return !ListDevices().empty();
-  } catch (const Error&) {
-    return false;
-  }
-}
 
 bool HavePrlimit() { return std::system("prlimit --version >/dev/null 2>&1") == 0; }
 

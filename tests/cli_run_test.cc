@@ -21,15 +21,8 @@ namespace sapmvs {
 namespace {
 
 namespace fs = std::filesystem;
+using test::HaveOpenClDevice;
 using test::RunCli;
-
-bool HaveOpenClDevice() {
-  try {
-    return !ListDevices().empty();
-  } catch (const Error&) {
-    return false;
-  }
-}
 
 class CliRunTest : public ::testing::Test {
  protected:

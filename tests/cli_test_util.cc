@@ -8,6 +8,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "cl_runtime.h"
+#include "sapmvs/error.h"
+
 namespace sapmvs::test {
 
 CliResult RunCli(const std::string& args, const std::string& env) {
@@ -40,6 +43,14 @@ int CountLines(const std::string& text) {
   for (char c : text) n += c == '\n';
   if (!text.empty() && text.back() != '\n') ++n;
   return n;
+}
+
+bool HaveOpenClDevice() {
+  try {
+    return !ListDevices().empty();
+  } catch (const Error&) {
+    return false;
+  }
 }
 
 }  // namespace sapmvs::test

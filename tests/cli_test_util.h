@@ -17,4 +17,7 @@ CliResult RunCli(const std::string& args, const std::string& env = "");
 
 int CountLines(const std::string& text);
 
+// Whether an OpenCL device is there for the CLI's matching to run on.
+bool HaveOpenClDevice();
+
 }  // namespace sapmvs::test
