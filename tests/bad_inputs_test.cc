@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -28,9 +27,9 @@ namespace fs = std::filesystem;
 constexpr const char* kSection = "## Block, orientation and image files";
 constexpr const char* kSuite = "BadInputRow";
 // Every case is run under `timeout`: a hang fails the case instead of the
-// suite. The FIFO cases must end well before.
+// suite. No bound tighter than that: tests do not time (a loaded CI machine
+// takes seconds to start a process), and a hang is what the FIFO cases test.
 constexpr int kTimeoutSeconds = 60;
-constexpr double kFastSeconds = 10;
 
 using Case = BadInputCase;
 
@@ -92,13 +91,9 @@ class BadInputRow : public ::testing::Test {
     const std::map<std::string, Row> rows = ReadRows();
     const fs::path dir = ScratchDir();
     case_.setup(dir);
-    const auto t0 = std::chrono::steady_clock::now();
     const CliResult r = RunCli(ReplaceAll(case_.args, "{D}", Dir(dir)),
                                "timeout " + std::to_string(kTimeoutSeconds));
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ASSERT_NE(r.exit_code, 124) << "sapmvs hung: killed after " << kTimeoutSeconds << " s";
-    EXPECT_LT(seconds, kFastSeconds) << "a bad input must be refused at once";
     EXPECT_EQ(CountLines(r.err), 1) << "expected one line on stderr, got:\n" << r.err;
     std::string message = r.err;
     while (!message.empty() && message.back() == '\n') message.pop_back();
