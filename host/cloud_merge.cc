@@ -41,7 +41,11 @@ struct CellKey {
 };
 struct CellHash {
   size_t operator()(const CellKey& k) const {
-    return static_cast<size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
+    // Unsigned: the products wrap, where signed ones overflowed (undefined)
+    // for cells of UTM-sized coordinates (UBSan, CloudMerge tests).
+    return static_cast<size_t>(static_cast<uint64_t>(k.x) * 73856093ULL ^
+                               static_cast<uint64_t>(k.y) * 19349663ULL ^
+                               static_cast<uint64_t>(k.z) * 83492791ULL);
   }
 };
 

@@ -134,6 +134,9 @@ cv::Mat Grey(const cv::Mat& bgr) {
 }
 
 double Bilinear(const cv::Mat& g, double x, double y) {
+  // Checked before the cast: a NaN or huge coordinate cast to int is
+  // undefined (UBSan).
+  if (!(x >= 0 && y >= 0 && x < g.cols && y < g.rows)) return std::nan("");
   const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
   if (x0 < 0 || y0 < 0 || x0 + 1 >= g.cols || y0 + 1 >= g.rows) return std::nan("");
   const double fx = x - x0, fy = y - y0;
