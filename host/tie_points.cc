@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <opencv2/core/hal/hal.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -120,10 +121,7 @@ std::vector<std::pair<int, int>> MatchPair(const ImageFeatures& a, const ImageFe
     band.clear();
     for (int j = 0; j < static_cast<int>(b.uv.size()); ++j) {
       if (std::abs(line.x() * b.uv[j].x() + line.y() * b.uv[j].y() + line.z()) > reach) continue;
-      const float* db = b.descriptors.ptr<float>(j);
-      float d2 = 0;
-      for (int k = 0; k < dims; ++k) d2 += (da[k] - db[k]) * (da[k] - db[k]);
-      band.emplace_back(d2, j);
+      band.emplace_back(cv::hal::normL2Sqr_(da, b.descriptors.ptr<float>(j), dims), j);
     }
     if (band.empty()) continue;
     std::sort(band.begin(), band.end());
@@ -214,18 +212,16 @@ std::vector<TiePoint> TriangulateTiePoints(const Block& block, const TiePointOpt
     if (!block.images[i].path.empty()) with_files.push_back(i);
   }
   if (with_files.size() < 2) return {};
-  std::string error;
   // One image at a time: SIFT's pyramid of an image doubled in size is about
   // 60 MB at 600 px, and two at once set the run's peak memory. OpenCV
   // spreads each image's pyramid and descriptors over the cores itself.
-  for (size_t k = 0; k < with_files.size(); ++k) {
-    try {
-      images[with_files[k]] = Detect(block.images[with_files[k]], block.origin, o);
-    } catch (const std::exception& e) {
-      if (error.empty()) error = e.what();
-    }
+  try {
+    for (const int i : with_files) images[i] = Detect(block.images[i], block.origin, o);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // OpenCV's, as one of ours
+    throw Error(e.what());
   }
-  if (!error.empty()) throw Error(error);
 
   const std::vector<std::pair<int, int>> pairs = ChoosePairs(images, o);
   std::vector<std::vector<std::pair<int, int>>> matches(pairs.size());

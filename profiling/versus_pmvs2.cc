@@ -334,17 +334,16 @@ int main(int argc, char** argv) {
             r.from_pmvs2[k] =
                 static_cast<double>(CountWithNeighbour(theirs, r.cloud, radius, &has)) /
                 theirs.points.size();
-            if (k == 1 && truth) {
+            // PMVS2's row comes first, so its own check is done by now.
+            const std::optional<SurfaceCheck>& all = rows.front().truth;
+            if (k == 1 && all && all->within > 0) {
               PointCloud missed = theirs;
               missed.points.clear();
               for (size_t i = 0; i < has.size(); ++i) {
                 if (!has[i]) missed.points.push_back(theirs.points[i]);
               }
-              const SurfaceCheck all = CheckAgainstTruth(theirs, *truth, block, gsd, level);
               const SurfaceCheck miss = CheckAgainstTruth(missed, *truth, block, gsd, level);
-              if (all.within > 0) {
-                r.right_from_pmvs2 = 1.0 - static_cast<double>(miss.within) / all.within;
-              }
+              r.right_from_pmvs2 = 1.0 - static_cast<double>(miss.within) / all->within;
             }
           }
           if (!r.cloud.points.empty()) {

@@ -6,7 +6,4 @@ namespace sapmvs {
 // Peak resident set size of this process so far, bytes (getrusage).
 double PeakRssBytes();
 
-// Resident set size now, bytes (/proc/self/statm); 0 where unknown.
-double CurrentRssBytes();
-
 }  // namespace sapmvs
