@@ -123,12 +123,9 @@ BlockFormat DetectBlockFormat(const fs::path& path) {
               "cameras.txt + images.txt (or .bin), txt/NNNNNNNN.txt, *.camera; or give --format)");
 }
 
-Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
-  if (const std::string p = options.Problem(); !p.empty()) {
-    throw Error("block read options: expected " + p);
-  }
-  const BlockFormat format =
-      options.format == BlockFormat::kAuto ? DetectBlockFormat(path) : options.format;
+namespace {
+
+Block ReadBlockAs(const fs::path& path, BlockFormat format, const BlockReadOptions& options) {
   Block block;
   switch (format) {
     case BlockFormat::kYaml:
@@ -148,6 +145,27 @@ Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
       break;
     case BlockFormat::kAuto:
       break;
+  }
+  return block;
+}
+
+}  // namespace
+
+Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
+  if (const std::string p = options.Problem(); !p.empty()) {
+    throw Error("block read options: expected " + p);
+  }
+  const BlockFormat format =
+      options.format == BlockFormat::kAuto ? DetectBlockFormat(path) : options.format;
+  Block block;
+  try {
+    block = ReadBlockAs(path, format, options);
+  } catch (const fs::filesystem_error& e) {
+    // A path the system refuses (too long, a loop of links) as one line that
+    // names the block; the path itself may be kilobytes of a hostile file.
+    std::string what = e.path1().string();
+    if (what.size() > 120) what = what.substr(0, 120) + "...";
+    throw Error(path.string() + ": " + e.code().message() + ": " + what);
   }
   block.source = path;
   if (options.ground_height) block.ground_height = options.ground_height;

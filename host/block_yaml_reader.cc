@@ -146,7 +146,13 @@ class ImageLocator {
       folder_ = override_dir;
     } else if (node.IsScalar()) {
       folder_ = base / f.As<std::string>(node, "an image folder");
-      if (!fs::is_directory(folder_)) f.Fail(node, "image folder not found: " + folder_.string());
+      // The error_code form: a name too long for the system is "not found"
+      // here, where the throwing form escaped as a filesystem_error (fuzzing).
+      std::error_code ec;
+      if (!fs::is_directory(folder_, ec)) {
+        f.Fail(node, "image folder not found: " + folder_.string() +
+                         (ec ? " (" + ec.message() + ")" : ""));
+      }
     } else if (node.IsSequence()) {
       for (const auto& item : node) {
         const fs::path p = base / f.As<std::string>(item, "an image file name");

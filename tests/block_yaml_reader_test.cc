@@ -268,5 +268,22 @@ TEST(YamlReader, InvalidYamlNamesTheLine) {
   }
 }
 
+// Found by fuzzing (scripts/fuzz.sh block_yaml): an image folder name longer
+// than the system allows escaped as std::filesystem_error, not as a line that
+// names block.yaml.
+TEST(YamlReader, ImageFolderNameTooLongNamesTheLine) {
+  const fs::path dir = test::ScratchDir();
+  std::ofstream(dir / "block.yaml")
+      << "camera: {width: 8, height: 6, focal_mm: 6, pixel_um: 2}\nimages: "
+      << std::string(5000, 'x') << "\norientation: {file: o.txt}\n";
+  try {
+    ReadBlock(dir / "block.yaml");
+    FAIL() << "expected an error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_NE(std::string(e.what()).find("image folder not found"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace sapmvs
