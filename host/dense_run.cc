@@ -161,27 +161,9 @@ RunReport RunDense(const RunOptions& options) {
     throw Error(reason);
   }
   const GroupingOptions gopt = options.Grouping();
-  GroupingPlan plan;
-  ImageGroup all;
-  all.images.resize(block.images.size());
-  std::iota(all.images.begin(), all.images.end(), 0);
-  all.memory = EstimateGroupMemory(block, all.images, options.matcher);
-  if (static_cast<int>(block.images.size()) <= gopt.max_images &&
-      all.memory.Total() <= gopt.memory_budget) {
-    // Small enough for one group: splitting would only lose views.
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (const BlockImage& im : block.images) {
-      sum += im.camera.center().head<2>() - block.origin.head<2>();
-    }
-    all.center = sum / std::max<size_t>(1, block.images.size());
-    plan.strategy = gopt.strategy;
-    plan.groups.push_back(all);
-    report.strategy = "single group";
-  } else {
-    plan = PlanGroups(block, gopt, &geometry);
-    report.strategy = ToString(plan.strategy);
-    for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
-  }
+  const GroupingPlan plan = PlanGroups(block, gopt, &geometry);
+  report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
+  for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   end_stage("plan");
 
   DeviceOptions device_options;

@@ -484,6 +484,19 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     throw Error(reason);
   }
   const std::vector<Footprint> fp = Footprints(block, geometry);
+  ImageGroup all;
+  all.images.resize(block.images.size());
+  std::iota(all.images.begin(), all.images.end(), 0);
+  all.memory = EstimateGroupMemory(block, all.images, options.level);
+  if (static_cast<int>(all.images.size()) <= options.max_images &&
+      all.memory.Total() <= options.memory_budget) {
+    for (const int i : all.images) all.center += fp[i].center;
+    all.center /= static_cast<double>(all.images.size());
+    all.short_of_views = ShortOfViews(fp, all.images, options.min_image_num);
+    plan.groups.push_back(all);
+    plan.single_group = true;
+    return plan;
+  }
   if (options.strategy == GroupingStrategy::kStrip)
     PlanStrips(block, options, fp, &plan);
   else

@@ -47,7 +47,9 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
   if (plan.strategy == GroupingStrategy::kFootprint)
     out << ", tiles of " << Fixed(o.tile_size, 2) << " footprint, " << o.tile_views << " views";
   out << "\n";
-  out << "groups      " << plan.groups.size() << "\n";
+  out << "groups      " << plan.groups.size();
+  if (plan.single_group) out << " (single group: the block fits one, so it is not split)";
+  out << "\n";
 
   std::vector<std::array<std::string, 8>> rows;
   rows.push_back({"group", "strip", "image numbers", "image names", "images", "centre X, Y",
@@ -107,6 +109,7 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
   j["images"] = block.images.size();
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["strategy"] = ToString(plan.strategy);
+  j["single_group"] = plan.single_group;
   j["options"] = {{"max_images", o.max_images}, {"memory_budget", o.memory_budget},
                   {"level", o.level},           {"tile_size", o.tile_size},
                   {"tile_views", o.tile_views}, {"min_image_num", o.min_image_num}};

@@ -85,6 +85,16 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
   EXPECT_EQ(j.at("mode"), "sapmvs");
   EXPECT_EQ(j.at("level"), 1);
   EXPECT_EQ(j.at("images"), 4);
+  // `plan` with the same flags shows the groups the run matched.
+  const fs::path plan_json = out_.string() + "_plan.json";  // not among the run's files
+  const auto plan = RunCli("plan " + Block().string() + " --json " + plan_json.string());
+  ASSERT_EQ(plan.exit_code, 0) << plan.err;
+  std::ifstream plan_in(plan_json);
+  const nlohmann::json p = nlohmann::json::parse(plan_in);
+  ASSERT_EQ(p.at("groups").size(), j.at("groups").size()) << p.at("groups");
+  for (size_t g = 0; g < p.at("groups").size(); ++g) {
+    EXPECT_EQ(p.at("groups")[g].at("names"), j.at("groups")[g].at("images"));
+  }
   ASSERT_TRUE(j.at("stages").is_array());
   ASSERT_FALSE(j.at("stages").empty());
   for (const auto& stage : j.at("stages")) {

@@ -103,6 +103,34 @@ TEST(GroupingTable3, CampusStripStrategyMatchesThePaper) {
   EXPECT_TRUE(plan.ungrouped.empty());
 }
 
+// `run` matches what PlanGroups returns; a block that fits one group is not
+// split, whatever the strategy, since splitting it would only lose views.
+TEST(GroupingSingle, ABlockThatFitsIsOneGroupAndALargerOneIsSplit) {
+  const SimBlock s = MakeSimBlock("tiny");
+  ASSERT_EQ(s.block.images.size(), 4u);
+  for (const GroupingStrategy strategy : {GroupingStrategy::kStrip, GroupingStrategy::kFootprint}) {
+    GroupingOptions o;
+    o.strategy = strategy;
+    const GroupingPlan one = PlanGroups(s.block, o);
+    EXPECT_TRUE(one.single_group);
+    ASSERT_EQ(one.groups.size(), 1u);
+    EXPECT_EQ(one.groups[0].images, (std::vector<int>{0, 1, 2, 3}));
+    EXPECT_GT(one.groups[0].memory.Total(), 0);
+
+    o.max_images = 3;  // fewer than the block's images
+    const GroupingPlan split = PlanGroups(s.block, o);
+    EXPECT_FALSE(split.single_group);
+    EXPECT_GT(split.groups.size(), 1u);
+
+    o.max_images = 6;
+    // Three images fit, the whole block does not.
+    o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, o.level).Total();
+    const GroupingPlan budget = PlanGroups(s.block, o);
+    EXPECT_FALSE(budget.single_group);
+    for (const ImageGroup& g : budget.groups) EXPECT_LE(g.memory.Total(), o.memory_budget);
+  }
+}
+
 TEST(GroupingTable3, GroupCentresLieOnTheirImagesFootprints) {
   const SimBlock s = MakeSimBlock("campus");
   const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});

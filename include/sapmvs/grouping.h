@@ -120,16 +120,20 @@ struct GroupingPlan {
   std::vector<std::vector<int>> strips;  // detected strips, images in flight order
   std::vector<ImageGroup> groups;
   std::vector<int> ungrouped;  // images in no group (see PlanGroups)
+  // The whole block is one group: it has at most max_images images and fits
+  // memory_budget, and splitting it would only lose views.
+  bool single_group = false;
 };
 
-// Plans the groups of `block`. Strip strategy: a strip of one image joins the
-// group nearest to it that has room, else it is left ungrouped; a run of one
-// image left at the end of a strip takes one image from the run before it (or
-// shares it, when max_images is 2), so no group has a single image; a block
-// with no strip of 2 or more images (terrestrial, convergent) is cut in block
-// order as one strip, its groups with strip -1. Footprint strategy: images without a surface
-// estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error for bad options, a block
-// of fewer than 2 images, and when 2 images do not fit memory_budget.
+// Plans the groups of `block`. A block of at most max_images images whose
+// estimate fits memory_budget is one group (single_group), whatever the
+// strategy: `plan` and `run` both show what this returns. Strip strategy: a strip of one image
+// joins the group nearest to it that has room, else it is left ungrouped; a run of one image left
+// at the end of a strip takes one image from the run before it (or shares it, when max_images is
+// 2), so no group has a single image; a block with no strip of 2 or more images (terrestrial,
+// convergent) is cut in block order as one strip, its groups with strip -1. Footprint strategy:
+// images without a surface estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error
+// for bad options, a block of fewer than 2 images, and when 2 images do not fit memory_budget.
 // `geometry`: EstimateBlockGeometry(block) when the caller has it (it reads
 // the block's DEM), else nullptr and it is estimated here.
 GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
