@@ -146,8 +146,9 @@ void ExpectSameCameras(const Block& a, const Block& b) {
   for (size_t i = 0; i < a.images.size(); ++i) {
     SCOPED_TRACE(a.images[i].name);
     EXPECT_EQ(a.images[i].name, b.images[i].name);
-    if (!a.images[i].camera_name.empty())
+    if (!a.images[i].camera_name.empty()) {
       EXPECT_EQ(a.images[i].camera_name, b.images[i].camera_name);
+    }
     const Intrinsics &ka = a.images[i].camera.intrinsics(), &kb = b.images[i].camera.intrinsics();
     EXPECT_EQ(ka.width, kb.width);
     EXPECT_EQ(ka.height, kb.height);

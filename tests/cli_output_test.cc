@@ -17,7 +17,7 @@
 #include "cli_test_util.h"
 #include "sapmvs/error.h"
 #include "sapmvs/output_folder.h"
-#include "sapmvs/simulate.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
@@ -89,20 +89,10 @@ class CliOutputTest : public ::testing::Test {
     fs::remove_all(out_);
   }
 
-  // The tiny block at half scale (seconds), simulated on first use only:
-  // most tests here are refused before any block is read.
-  static fs::path Block() {
-    const fs::path dir = *root_ / "tiny";
-    if (!fs::exists(dir / "block.yaml")) {
-      SimulateOptions o;
-      o.preset = "tiny";
-      o.scale = 0.5;
-      o.out = dir;
-      o.quiet = true;
-      Simulate(o);
-    }
-    return dir / "block.yaml";
-  }
+  // The tiny block at half scale (seconds), simulated on first use only
+  // (most tests here are refused before any block is read) and shared by
+  // the test processes: read only.
+  static fs::path Block() { return test::Simulated("tiny", 1, 0.5) / "block.yaml"; }
   static fs::path NoBlock() { return *root_ / "no_block" / "block.yaml"; }
   // Two groups (one per strip), each matched in 2 images.
   static std::string Run(const fs::path& block, const fs::path& out, const std::string& more = "") {
@@ -192,11 +182,17 @@ TEST_F(CliOutputTest, NoOpenClPlatformLeavesNothingBehind) {
 // The CRS is needed only by cloud.las and dsm.tif, written after all the
 // matching; it is checked before any.
 TEST_F(CliOutputTest, InvalidCrsIsRefusedBeforeAnyWork) {
-  const fs::path block = Block().parent_path() / "bad_crs.yaml";
+  const fs::path block = *root_ / "bad_crs.yaml";  // the shared block stays as it is
   std::string yaml = Slurp(Block());
-  const size_t at = yaml.find("crs: ");
-  ASSERT_NE(at, std::string::npos) << yaml;
-  yaml.replace(at, yaml.find('\n', at) - at, "crs: \"hello\"");
+  const auto set = [&](const std::string& key, const std::string& value) {
+    const size_t at = yaml.find(key);
+    ASSERT_NE(at, std::string::npos) << yaml;
+    yaml.replace(at, yaml.find('\n', at) - at, key + value);
+  };
+  set("crs: ", "\"hello\"");
+  set("images: ", (Block().parent_path() / "images").string());
+  set("file: ", (Block().parent_path() / "orientation.txt").string());
+  set("dem: ", (Block().parent_path() / "truth" / "dsm.tif").string());
   Spit(block, yaml);
   const auto r = RunCli(Run(block, out_), "OCL_ICD_VENDORS=/tmp/none");
   EXPECT_EQ(r.exit_code, 1);  // before the device is looked for

@@ -146,8 +146,7 @@ class MatchGroupTest : public test::ClTest {
 
  protected:
   // The tiny preset, simulated once per test process (in-process, ~6 s).
-  static fs::path TinyDir() { return test::Simulated("matcher_test_tiny", "tiny", 1); }
-  static void TearDownTestSuite() { test::RemoveSimulated("matcher_test_tiny"); }
+  static fs::path TinyDir() { return test::Simulated("tiny", 1); }
 
   static MatcherOptions Options(MatchMode mode) {
     MatcherOptions o;

@@ -3,9 +3,12 @@
 #include "sapmvs/error.h"
 #include "sapmvs/simulate.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <Eigen/Dense>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -14,37 +17,76 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 namespace sapmvs::test {
 
 std::filesystem::path TestDir() { return SAPMVS_TEST_DIR; }
 
 namespace {
-std::filesystem::path SimulatedPath(const std::string& tag) {
-  return std::filesystem::temp_directory_path() /
-         ("sapmvs_" + tag + "_" + std::to_string(::getpid()));
+
+namespace fs = std::filesystem;
+
+// This test binary's identity (size and modification time): a cache made by
+// another build may hold another simulator's images.
+std::string BinaryKey() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return "pid" + std::to_string(::getpid());
+  const auto size = fs::file_size(exe, ec);
+  const auto time = fs::last_write_time(exe, ec).time_since_epoch().count();
+  return std::to_string(std::hash<std::string>{}(exe.string())) + "_" + std::to_string(size) + "_" +
+         std::to_string(time);
 }
+
+// Drops the caches of other builds of this binary left an hour or more ago.
+void RemoveStaleCaches(const fs::path& keep) {
+  std::error_code ec;
+  const auto now = fs::file_time_type::clock::now();
+  for (const auto& e : fs::directory_iterator(fs::temp_directory_path(), ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("sapmvs_sim_cache_", 0) != 0 || e.path() == keep) continue;
+    std::error_code ec2;
+    if (now - fs::last_write_time(e.path(), ec2) > std::chrono::hours(1))
+      fs::remove_all(e.path(), ec2);
+  }
+}
+
 }  // namespace
 
-std::filesystem::path Simulated(const std::string& tag, const std::string& preset, int seed) {
-  static std::map<std::string, std::filesystem::path> made;
-  auto it = made.find(tag);
-  if (it != made.end() && std::filesystem::exists(it->second)) return it->second;
-  const std::filesystem::path d = SimulatedPath(tag);
-  std::filesystem::remove_all(d);
-  SimulateOptions o;
-  o.preset = preset;
-  o.out = d;
-  o.seed = seed;
-  o.quiet = true;
-  Simulate(o);
-  made[tag] = d;
-  return d;
-}
-
-void RemoveSimulated(const std::string& tag) {
-  std::error_code ec;
-  std::filesystem::remove_all(SimulatedPath(tag), ec);
+fs::path Simulated(const std::string& preset, int seed, double scale) {
+  static std::map<std::string, fs::path> made;
+  std::ostringstream id;
+  id << preset << "_seed" << seed << "_scale" << scale;
+  if (auto it = made.find(id.str()); it != made.end()) return it->second;
+  const fs::path cache = fs::temp_directory_path() / ("sapmvs_sim_cache_" + BinaryKey());
+  fs::create_directories(cache);
+  const fs::path dir = cache / id.str();
+  // One process simulates; the others of a parallel ctest wait for it.
+  const int lock = ::open((cache / (id.str() + ".lock")).c_str(), O_CREAT | O_RDWR, 0644);
+  if (lock < 0 || ::flock(lock, LOCK_EX) != 0) throw Error("cannot lock " + cache.string());
+  try {
+    if (!fs::exists(dir / "block.yaml")) {
+      const fs::path tmp = cache / (id.str() + ".tmp." + std::to_string(::getpid()));
+      fs::remove_all(tmp);
+      SimulateOptions o;
+      o.preset = preset;
+      o.out = tmp;
+      o.seed = seed;
+      o.scale = scale;
+      o.quiet = true;
+      Simulate(o);
+      fs::remove_all(dir);
+      fs::rename(tmp, dir);  // complete or absent
+      RemoveStaleCaches(cache);
+    }
+  } catch (...) {
+    ::close(lock);
+    throw;
+  }
+  ::close(lock);
+  made[id.str()] = dir;
+  return dir;
 }
 
 std::filesystem::path SharedDir() {

@@ -22,11 +22,12 @@ std::filesystem::path SharedDir();
 // A fresh, empty directory under the system temp dir, unique per test.
 std::filesystem::path ScratchDir();
 
-// The simulator's `preset` rendered with `seed` into a temp folder named for
-// `tag` and this process, once per process (tiny takes seconds); the caller
-// removes it (RemoveSimulated) when its tests are done.
-std::filesystem::path Simulated(const std::string& tag, const std::string& preset, int seed);
-void RemoveSimulated(const std::string& tag);
+// The simulator's `preset` rendered with `seed` at `scale`, simulated once
+// for every test process of this build (under a lock, into a cache in the
+// temp folder keyed by the test binary) instead of once per process: ctest
+// runs each test in its own process, and the CLI suites simulated tiny in
+// every one. Read only: a test that needs a changed block copies it.
+std::filesystem::path Simulated(const std::string& preset, int seed, double scale = 1.0);
 
 // Kernel-versus-reference comparison: |actual - expected| <= abs_tol + rel_tol
 // * |expected|, and NaN exactly where the reference has NaN (border policies

@@ -16,12 +16,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The tiny preset, simulated once per test process.
-fs::path TinyDir() { return test::Simulated("tie_points_test_tiny", "tiny", 3); }
+// The tiny preset (shared by the test processes, read only).
+fs::path TinyDir() { return test::Simulated("tiny", 3); }
 
 class TiePointsTest : public ::testing::Test {
  protected:
-  static void TearDownTestSuite() { test::RemoveSimulated("tie_points_test_tiny"); }
   // The simulated block as a user without a surface prior brings it.
   static Block NoPrior() {
     Block b = ReadBlock(TinyDir() / "block.yaml");
