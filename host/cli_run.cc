@@ -42,14 +42,20 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   MatcherOptions& m = o->matcher;
   CLI::App* cmd = app.add_subcommand(
       "run", "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json");
+  cmd->option_defaults()->group("Input");
   cmd->add_option("block", o->block,
                   "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
       ->required();
+  cmd->option_defaults()->group("Output and resume");
   cmd->add_option("--out", o->out, "Output folder")->required();
+  cmd->option_defaults()->group("Input");
   AddBlockFlags(cmd, block_flags.get());
+  cmd->option_defaults()->group("Matching");
   cmd->add_option("--mode", *mode, "sapmvs (self-adaptive patch) or pmvs")->capture_default_str();
+  cmd->option_defaults()->group("Device");
   cmd->add_option("--device", o->device,
                   "OpenCL device: index or name substring (see `sapmvs devices`)");
+  cmd->option_defaults()->group("Matching");
   cmd->add_option("--level", m.level, "Pyramid level: 0 full resolution, 1 half, ...")
       ->capture_default_str();
   cmd->add_option("--csize", m.cell_size, "Cell size, pixels at the level")->capture_default_str();
@@ -74,6 +80,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
          "--ncc-sigma-color", m.ncc_sigma_color,
          "sapmvs: NCC sample weights, in SDs of the texture at the window's centre (0 = plain NCC)")
       ->capture_default_str();
+  cmd->option_defaults()->group("Seeds and edges");
   cmd->add_option("--features-per-block", m.features_per_block,
                   "Features per detector per 32x32 block")
       ->capture_default_str();
@@ -83,12 +90,14 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   cmd->add_option("--candidates", m.candidates_per_feature, "Seed candidates tried per feature")
       ->capture_default_str();
   cmd->add_flag("--no-edges", *no_edges, "sapmvs: do not match edges (no propagation barriers)");
+  cmd->option_defaults()->group("Propagation");
   cmd->add_option("--max-wave", m.max_wave, "Most candidates per device launch")
       ->capture_default_str();
   cmd->add_option("--max-waves", m.max_waves, "Stop after this many waves (0 = none)")
       ->capture_default_str();
   cmd->add_option("--expand-iterations", m.expand_iterations, "Expand-then-filter passes (PMVS: 3)")
       ->capture_default_str();
+  cmd->option_defaults()->group("Filter");
   cmd->add_option(
          "--score-fence", m.score_fence,
          "Filter: robust SDs below the first pass's median score a point may lie (0 = off)")
@@ -109,16 +118,19 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--min-cluster", m.min_cluster_size, "Filter: smallest cluster kept, points")
       ->capture_default_str();
+  cmd->option_defaults()->group("Grouping");
   cmd->add_option("--strategy", *strategy, "Grouping: strip (the paper) or footprint")
       ->capture_default_str();
   cmd->add_option("--max-images", o->grouping.max_images, "Most images per group")
       ->capture_default_str();
   cmd->add_option("--memory-budget", *budget, "Memory one group may use (8G, 512M, ...)")
       ->capture_default_str();
+  cmd->option_defaults()->group("Output and resume");
   cmd->add_flag("--restart", o->restart, "Discard the checkpoints in DIR/groups and start over");
   cmd->add_option("--max-groups", o->max_groups,
                   "Match at most this many groups now, then stop (resumable; 0 = all)")
       ->capture_default_str();
+  cmd->option_defaults()->group("Merge and DSM");
   cmd->add_option("--merge-radius", o->merge_radius_gsd,
                   "Merge: duplicate distance, GSDs of the level matched")
       ->capture_default_str();
@@ -127,11 +139,21 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--dsm-fill", o->dsm.fill_passes, "DSM gap-filling passes")
       ->capture_default_str();
+  cmd->option_defaults()->group("Output and resume");
   CLI::Option* profile_option =
       cmd->add_option("--profile", *profile,
                       "Profile the kernels and phases: print tables, write FILE (CSV) and its "
                       ".json (default DIR/profile.csv)")
           ->expected(0, 1);
+  cmd->footer(
+      "Examples:\n"
+      "  sapmvs run block.yaml --out out/run              SAPMVS at level 1, the defaults\n"
+      "  sapmvs run block.yaml --out out/run --level 0    full resolution\n"
+      "  sapmvs run colmap/sparse --out out/run --mode pmvs   PMVS's fixed 7x7 patch\n"
+      "  sapmvs run block.yaml --out out/run --max-groups 1   one group now; the same\n"
+      "                                                   command later resumes\n"
+      "  sapmvs run block.yaml --out out/run --restart    discard the checkpoints\n"
+      "Outputs in DIR: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json, groups/.");
   cmd->callback(
       [o, block_flags, mode, no_edges, strategy, budget, profile, profile_option, &global] {
         o->read = ReadOptionsOf(*block_flags);

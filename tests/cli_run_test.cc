@@ -15,7 +15,7 @@
 #include "sapmvs/cloud_merge.h"
 #include "sapmvs/error.h"
 #include "sapmvs/ply_io.h"
-#include "sapmvs/simulate.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
@@ -26,17 +26,12 @@ using test::RunCli;
 
 class CliRunTest : public ::testing::Test {
  protected:
-  // One simulated tiny block for the suite, in a folder unique to the process.
+  // Outputs in a folder unique to the process; the tiny block is shared.
   static void SetUpTestSuite() {
     root_ = new fs::path(fs::temp_directory_path() /
                          ("sapmvs_cli_run_test_" + std::to_string(::getpid())));
     fs::remove_all(*root_);
-    SimulateOptions o;
-    o.preset = "tiny";
-    o.out = *root_ / "tiny";
-    o.seed = 1;
-    o.quiet = true;
-    Simulate(o);
+    fs::create_directories(*root_);
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -50,7 +45,7 @@ class CliRunTest : public ::testing::Test {
     fs::remove_all(out_);
   }
 
-  static fs::path Block() { return *root_ / "tiny" / "block.yaml"; }
+  static fs::path Block() { return test::Simulated("tiny", 1) / "block.yaml"; }
   // Nothing at all under the output folder (or no folder).
   bool NoOutput() const { return !fs::exists(out_) || fs::is_empty(out_); }
 
@@ -59,6 +54,33 @@ class CliRunTest : public ::testing::Test {
 };
 
 fs::path* CliRunTest::root_ = nullptr;
+
+// `run` has some 40 flags: its help shows them in sections, with examples.
+TEST(CliRunHelp, ShowsSectionsAndExamples) {
+  const auto r = RunCli("run --help");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  size_t last = 0;
+  // The sections in the order a user meets them, each with one of its flags.
+  for (const auto& [section, flag] :
+       std::vector<std::pair<std::string, std::string>>{{"Input:", "--image-dir"},
+                                                        {"Output and resume:", "--restart"},
+                                                        {"Matching:", "--level"},
+                                                        {"Device:", "--device"},
+                                                        {"Seeds and edges:", "--no-edges"},
+                                                        {"Propagation:", "--max-wave"},
+                                                        {"Filter:", "--min-cluster"},
+                                                        {"Grouping:", "--memory-budget"},
+                                                        {"Merge and DSM:", "--dsm-cell"}}) {
+    const size_t at = r.out.find("\n" + section + "\n");
+    ASSERT_NE(at, std::string::npos) << section << " missing in:\n" << r.out;
+    EXPECT_GT(at, last) << section << " out of order";
+    last = at;
+    const size_t next = r.out.find(":\n", at + section.size() + 2);
+    const std::string body = r.out.substr(at, next == std::string::npos ? next : next - at);
+    EXPECT_NE(body.find(flag), std::string::npos) << flag << " not under " << section;
+  }
+  EXPECT_NE(r.out.find("Examples:\n  sapmvs run block.yaml --out"), std::string::npos) << r.out;
+}
 
 TEST_F(CliRunTest, WritesCloudAndReport) {
   if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
