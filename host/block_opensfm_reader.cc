@@ -209,6 +209,54 @@ GeoReference ReadReference(const JsonFile& f, const json& obj, int missing_line)
   return r;
 }
 
+// Moves an OpenSfM block with a reference point into UTM, from whichever of
+// the frames of topocentric_to_utm.h its cameras are in: ODM's UTM offset
+// when ODM kept the topocentric reconstruction beside it or when the shots'
+// GPS positions say so, else OpenSfM's topocentric frame.
+void Georeference(const GeoReference& reference, const std::string& reference_from,
+                  const fs::path& path, const std::vector<Eigen::Vector3d>& gps, Block* block) {
+  char note[640];
+  std::string evidence;
+  bool utm_offset = false;
+  if (fs::exists(path.parent_path() / "reconstruction.topocentric.json")) {
+    utm_offset = true;
+    evidence = "reconstruction.topocentric.json beside it";
+  } else if (gps.size() == block->images.size() && gps.size() >= 2) {
+    std::vector<Eigen::Vector3d> centres;
+    for (const BlockImage& im : block->images) centres.push_back(im.camera.center());
+    const FrameFit fit = FitFramesToGps(TopocentricToUtm(reference), centres, gps);
+    utm_offset = fit.utm_offset_rms < fit.topocentric_rms;
+    std::snprintf(note, sizeof(note),
+                  "camera centres %.3g m RMS from the shots' GPS read as UTM offsets, %.3g m "
+                  "read as topocentric",
+                  fit.utm_offset_rms, fit.topocentric_rms);
+    evidence = note;
+  }
+  if (utm_offset) {
+    MoveUtmOffsetToUtm(reference, block);
+    std::snprintf(note, sizeof(note),
+                  "UTM from ODM's reconstruction in UTM less the easting and northing of lat "
+                  "%.8f, lon %.8f (%s; %s)",
+                  reference.latitude, reference.longitude, reference_from.c_str(),
+                  evidence.c_str());
+    block->frame_note = note;
+    return;
+  }
+  const TopocentricToUtmReport moved = MoveTopocentricToUtm(reference, block);
+  std::snprintf(note, sizeof(note),
+                "UTM from OpenSfM's topocentric ENU about lat %.8f, lon %.8f, alt %.3f (%s%s%s); "
+                "camera rotations turned by the grid convergence %.4f deg, scale %.6f",
+                reference.latitude, reference.longitude, reference.altitude, reference_from.c_str(),
+                evidence.empty() ? "" : "; ", evidence.c_str(), moved.convergence_deg, moved.scale);
+  block->frame_note = note;
+  if (moved.max_reprojection_change_px >= 0) {
+    std::snprintf(note, sizeof(note),
+                  "; sparse points reproject within %.3g px of ENU (%d checked)",
+                  moved.max_reprojection_change_px, moved.points_checked);
+    block->frame_note += note;
+  }
+}
+
 fs::path JsonPath(const fs::path& given) {
   if (fs::is_regular_file(given)) return given;
   if (fs::is_regular_file(given / "reconstruction.json")) return given / "reconstruction.json";
@@ -259,6 +307,7 @@ Block ReadOpenSfmFile(const fs::path& path, const BlockReadOptions& options) {
     reference_from = lla_file.filename().string();
   }
 
+  std::vector<Eigen::Vector3d> gps;  // OpenSfM's topocentric GPS positions of the shots
   for (const auto& [id, shot] : rec["shots"].items()) {
     const std::string where = "shots/" + id;
     if (!shot.is_object() || !shot.contains("camera") || !shot["camera"].is_string()) {
@@ -281,6 +330,13 @@ Block ReadOpenSfmFile(const fs::path& path, const BlockReadOptions& options) {
     if (im.path.empty())
       f.Fail(id, where, "no image for shot '" + id + "' in " + image_dir.string());
     block.images.push_back(std::move(im));
+    // Optional metadata, used only to tell the frame: a shot without a
+    // usable one leaves the choice to the file layout.
+    const json* g = shot.contains("gps_position") ? &shot["gps_position"] : nullptr;
+    if (g && g->is_array() && g->size() == 3 && (*g)[0].is_number() && (*g)[1].is_number() &&
+        (*g)[2].is_number()) {
+      gps.emplace_back((*g)[0].get<double>(), (*g)[1].get<double>(), (*g)[2].get<double>());
+    }
   }
   if (rec.contains("points") && rec["points"].is_object()) {
     for (const auto& [id, p] : rec["points"].items()) {
@@ -288,20 +344,7 @@ Block ReadOpenSfmFile(const fs::path& path, const BlockReadOptions& options) {
     }
   }
   if (reference) {
-    const TopocentricToUtmReport moved = MoveTopocentricToUtm(*reference, &block);
-    char note[512];
-    std::snprintf(note, sizeof(note),
-                  "UTM from OpenSfM's topocentric ENU about lat %.8f, lon %.8f, alt %.3f (%s); "
-                  "camera rotations turned by the grid convergence %.4f deg, scale %.6f",
-                  reference->latitude, reference->longitude, reference->altitude,
-                  reference_from.c_str(), moved.convergence_deg, moved.scale);
-    block.frame_note = note;
-    if (moved.max_reprojection_change_px >= 0) {
-      std::snprintf(note, sizeof(note),
-                    "; sparse points reproject within %.3g px of ENU (%d checked)",
-                    moved.max_reprojection_change_px, moved.points_checked);
-      block.frame_note += note;
-    }
+    Georeference(*reference, reference_from, path, gps, &block);
   } else {
     block.frame_note = "OpenSfM local frame (no reference_lla)";
   }

@@ -186,4 +186,39 @@ TopocentricToUtmReport MoveTopocentricToUtm(const GeoReference& reference, Block
   return report;
 }
 
+TopocentricToUtmReport MoveUtmOffsetToUtm(const GeoReference& reference, Block* block) {
+  const TopocentricToUtm map(reference);
+  const Eigen::Vector3d origin = map.Transform(Eigen::Vector3d::Zero());
+  const Eigen::Vector3d shift(origin.x(), origin.y(), 0);
+  for (BlockImage& im : block->images) {
+    const Camera& c = im.camera;
+    im.camera = Camera(c.intrinsics(), c.rotation(), c.center() + shift);
+  }
+  for (Eigen::Vector3d& p : block->sparse_points) p += shift;
+  TopocentricToUtmReport report;
+  report.epsg = map.epsg();
+  report.max_reprojection_change_px = block->sparse_points.empty() ? -1 : 0;
+  report.points_checked = static_cast<int>(block->sparse_points.size());
+  block->crs = "EPSG:" + std::to_string(map.epsg());
+  return report;
+}
+
+FrameFit FitFramesToGps(const TopocentricToUtm& map, const std::vector<Eigen::Vector3d>& centres,
+                        const std::vector<Eigen::Vector3d>& gps_enu) {
+  FrameFit fit;
+  if (centres.empty() || centres.size() != gps_enu.size()) return fit;
+  std::vector<Eigen::Vector3d> grid = gps_enu;
+  grid.push_back(Eigen::Vector3d::Zero());
+  map.Transform(&grid);
+  const Eigen::Vector3d origin = grid.back();
+  double topo = 0, offset = 0;
+  for (size_t i = 0; i < centres.size(); ++i) {
+    topo += (centres[i] - gps_enu[i]).head<2>().squaredNorm();
+    offset += (centres[i] - (grid[i] - origin)).head<2>().squaredNorm();
+  }
+  fit.topocentric_rms = std::sqrt(topo / static_cast<double>(centres.size()));
+  fit.utm_offset_rms = std::sqrt(offset / static_cast<double>(centres.size()));
+  return fit;
+}
+
 }  // namespace sapmvs

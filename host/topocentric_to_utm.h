@@ -82,4 +82,24 @@ struct TopocentricToUtmReport {
 // `reference` into its UTM zone and sets block->crs to "EPSG:n".
 TopocentricToUtmReport MoveTopocentricToUtm(const GeoReference& reference, Block* block);
 
+// OpenDroneMap (2.x) leaves as opensfm/reconstruction.json not OpenSfM's
+// topocentric reconstruction (kept as reconstruction.topocentric.json) but
+// its `export_geocoords` output: UTM easting and northing less those of the
+// reference point, heights as they are, reference_lla unchanged. Its move to
+// UTM is a translation, exact.
+TopocentricToUtmReport MoveUtmOffsetToUtm(const GeoReference& reference, Block* block);
+
+// Which of the two frames a reconstruction's camera centres are in, told by
+// the GPS positions OpenSfM stores with each shot (`gps_position`, always
+// topocentric): the horizontal RMS distance of the centres from them in each
+// reading. The two differ by the grid convergence times the distance from the
+// reference point (2 m at 140 m on the ODM block), well above what
+// alignment to the GPS leaves.
+struct FrameFit {
+  double topocentric_rms = 0;
+  double utm_offset_rms = 0;
+};
+FrameFit FitFramesToGps(const TopocentricToUtm& map, const std::vector<Eigen::Vector3d>& centres,
+                        const std::vector<Eigen::Vector3d>& gps_enu);
+
 }  // namespace sapmvs
