@@ -1,7 +1,8 @@
 #pragma once
 // A block in a local topocentric frame (OpenSfM's: east, north, up about a
 // geodetic reference point) moved into the UTM zone of that point, so that
-// every output carries an EPSG code.
+// every output carries an EPSG code; and ODM's variant of it, UTM less the
+// reference point (MoveUtmOffsetToUtm), told apart by FitFramesToGps.
 //
 // Points, camera centres included, go exactly: ENU -> ECEF (WGS84, by
 // formula) -> geodetic -> UTM through GDAL's OGR (PROJ). A camera's rotation
