@@ -2,13 +2,18 @@
 // Cameras: focal and principal point normalised by max(width, height), the
 // principal point as an offset from the image centre. Shots: `rotation` is an
 // angle-axis world-to-camera rotation, x_cam = R X + translation, OpenCV frame.
-// The world frame is topocentric ENU about `reference_lla`.
+// The world frame is topocentric ENU about the reference point given by the
+// reconstruction's `reference_lla` (newer OpenSfM) or by reference_lla.json
+// beside it (older OpenSfM, OpenDroneMap); with one, the block is moved into
+// that point's UTM zone (topocentric_to_utm.h), without one it stays in the
+// reconstruction's own frame.
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -16,6 +21,7 @@
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
+#include "topocentric_to_utm.h"
 
 namespace sapmvs {
 namespace fs = std::filesystem;
@@ -92,6 +98,12 @@ class JsonFile {
   }
 
   const json& root() const { return root_; }
+  const std::string& path() const { return path_; }
+  // The line of the first `"key"` in the file, or 0.
+  int LineOf(const std::string& key) const {
+    const size_t pos = text_.find("\"" + key + "\"");
+    return pos == std::string::npos ? 0 : LineAt(pos + 1);
+  }
 
   [[noreturn]] void Fail(const std::string& key, const std::string& json_path,
                          const std::string& message) const {
@@ -175,6 +187,76 @@ Intrinsics ReadCamera(const JsonFile& f, const std::string& id, const json& c) {
   return k;
 }
 
+// `latitude`, `longitude`, `altitude` of `obj`; errors name the line of the
+// key at fault, or `missing_line` for a key that is not there.
+GeoReference ReadReference(const JsonFile& f, const json& obj, int missing_line) {
+  const std::string where = "reference_lla";
+  GeoReference r;
+  double* values[] = {&r.latitude, &r.longitude, &r.altitude};
+  const char* keys[] = {"latitude", "longitude", "altitude"};
+  for (int i = 0; i < 3; ++i) {
+    if (!obj.is_object() || !obj.contains(keys[i])) {
+      throw InputError(
+          f.path(), missing_line,
+          where + ": missing number '" + keys[i] + "' (expected latitude, longitude and altitude)");
+    }
+    *values[i] = f.Number(obj, keys[i], where, keys[i]);
+  }
+  if (const std::string p = r.Problem(); !p.empty()) {
+    const char* key = p.find("longitude =") != std::string::npos ? "longitude" : "latitude";
+    f.Fail(key, where + "/" + key, "expected " + p);
+  }
+  return r;
+}
+
+// Moves an OpenSfM block with a reference point into UTM, from whichever of
+// the frames of topocentric_to_utm.h its cameras are in: ODM's UTM offset
+// when ODM kept the topocentric reconstruction beside it or when the shots'
+// GPS positions say so, else OpenSfM's topocentric frame.
+void Georeference(const GeoReference& reference, const std::string& reference_from,
+                  const fs::path& path, const std::vector<Eigen::Vector3d>& gps, Block* block) {
+  char note[640];
+  std::string evidence;
+  bool utm_offset = false;
+  if (fs::exists(path.parent_path() / "reconstruction.topocentric.json")) {
+    utm_offset = true;
+    evidence = "reconstruction.topocentric.json beside it";
+  } else if (gps.size() == block->images.size() && gps.size() >= 2) {
+    std::vector<Eigen::Vector3d> centres;
+    for (const BlockImage& im : block->images) centres.push_back(im.camera.center());
+    const FrameFit fit = FitFramesToGps(TopocentricToUtm(reference), centres, gps);
+    utm_offset = fit.utm_offset_rms < fit.topocentric_rms;
+    std::snprintf(note, sizeof(note),
+                  "camera centres %.3g m RMS from the shots' GPS read as UTM offsets, %.3g m "
+                  "read as topocentric",
+                  fit.utm_offset_rms, fit.topocentric_rms);
+    evidence = note;
+  }
+  if (utm_offset) {
+    MoveUtmOffsetToUtm(reference, block);
+    std::snprintf(note, sizeof(note),
+                  "UTM from ODM's reconstruction in UTM less the easting and northing of lat "
+                  "%.8f, lon %.8f (%s; %s)",
+                  reference.latitude, reference.longitude, reference_from.c_str(),
+                  evidence.c_str());
+    block->frame_note = note;
+    return;
+  }
+  const TopocentricToUtmReport moved = MoveTopocentricToUtm(reference, block);
+  std::snprintf(note, sizeof(note),
+                "UTM from OpenSfM's topocentric ENU about lat %.8f, lon %.8f, alt %.3f (%s%s%s); "
+                "camera rotations turned by the grid convergence %.4f deg, scale %.6f",
+                reference.latitude, reference.longitude, reference.altitude, reference_from.c_str(),
+                evidence.empty() ? "" : "; ", evidence.c_str(), moved.convergence_deg, moved.scale);
+  block->frame_note = note;
+  if (moved.max_reprojection_change_px >= 0) {
+    std::snprintf(note, sizeof(note),
+                  "; sparse points reproject within %.3g px of ENU (%d checked)",
+                  moved.max_reprojection_change_px, moved.points_checked);
+    block->frame_note += note;
+  }
+}
+
 fs::path JsonPath(const fs::path& given) {
   if (fs::is_regular_file(given)) return given;
   if (fs::is_regular_file(given / "reconstruction.json")) return given / "reconstruction.json";
@@ -207,20 +289,25 @@ Block ReadOpenSfmFile(const fs::path& path, const BlockReadOptions& options) {
   }
 
   Block block;
-  if (rec.contains("reference_lla") && rec["reference_lla"].is_object()) {
-    const json& r = rec["reference_lla"];
-    std::ostringstream note;
-    note.precision(10);
-    note << "topocentric ENU about lat "
-         << f.Number(r, "latitude", "reference_lla", "reference_lla") << ", lon "
-         << f.Number(r, "longitude", "reference_lla", "reference_lla") << ", alt "
-         << f.Number(r, "altitude", "reference_lla", "reference_lla") << " (OpenSfM reference_lla)";
-    block.frame_note = note.str();
-  } else {
-    block.frame_note = "OpenSfM local frame";
+  // Read before the shots: a bad reference point fails before image lookups.
+  std::optional<GeoReference> reference;
+  std::string reference_from;
+  const fs::path lla_file = path.parent_path() / "reference_lla.json";
+  if (rec.contains("reference_lla")) {
+    reference = ReadReference(f, rec["reference_lla"], f.LineOf("reference_lla"));
+    reference_from = "reference_lla in " + path.filename().string();
+  } else if (fs::exists(lla_file)) {
+    const JsonFile lla(lla_file);
+    if (!lla.root().is_object()) {
+      throw InputError(lla_file.string(), 1,
+                       "expected an object {\"latitude\": .., \"longitude\": .., "
+                       "\"altitude\": ..}");
+    }
+    reference = ReadReference(lla, lla.root(), 1);
+    reference_from = lla_file.filename().string();
   }
-  if (root.size() > 1) block.frame_note += "; reconstruction 1 of " + std::to_string(root.size());
 
+  std::vector<Eigen::Vector3d> gps;  // OpenSfM's topocentric GPS positions of the shots
   for (const auto& [id, shot] : rec["shots"].items()) {
     const std::string where = "shots/" + id;
     if (!shot.is_object() || !shot.contains("camera") || !shot["camera"].is_string()) {
@@ -243,12 +330,25 @@ Block ReadOpenSfmFile(const fs::path& path, const BlockReadOptions& options) {
     if (im.path.empty())
       f.Fail(id, where, "no image for shot '" + id + "' in " + image_dir.string());
     block.images.push_back(std::move(im));
+    // Optional metadata, used only to tell the frame: a shot without a
+    // usable one leaves the choice to the file layout.
+    const json* g = shot.contains("gps_position") ? &shot["gps_position"] : nullptr;
+    if (g && g->is_array() && g->size() == 3 && (*g)[0].is_number() && (*g)[1].is_number() &&
+        (*g)[2].is_number()) {
+      gps.emplace_back((*g)[0].get<double>(), (*g)[1].get<double>(), (*g)[2].get<double>());
+    }
   }
   if (rec.contains("points") && rec["points"].is_object()) {
     for (const auto& [id, p] : rec["points"].items()) {
       block.sparse_points.push_back(f.Vector3(p, "coordinates", "points/" + id, id));
     }
   }
+  if (reference) {
+    Georeference(*reference, reference_from, path, gps, &block);
+  } else {
+    block.frame_note = "OpenSfM local frame (no reference_lla)";
+  }
+  if (root.size() > 1) block.frame_note += "; reconstruction 1 of " + std::to_string(root.size());
   return block;
 }
 

@@ -13,6 +13,8 @@
 //   images: images/              # a folder (matched by name), or a list of files
 //   orientation:
 //     file: orientation.txt      # `name X Y Z a1 a2 a3 [camera]` per line
+//     format: plain              # or metashape | pix4d (orientation_export.h);
+//                                #   detected from the file when not given
 //     type: angles               # angles | rotation | projection
 //     angles: omega-phi-kappa    # or phi-omega-kappa (type: angles)
 //     units: deg                 # deg | gon | rad (type: angles)
@@ -25,6 +27,7 @@
 #include <map>
 
 #include "input_file.h"
+#include "orientation_export.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
@@ -164,15 +167,18 @@ class ImageLocator {
     }
   }
 
-  fs::path Find(const std::string& name, const TextLines& lines) const {
+  // `file` and `line` name where the orientation lists `name`.
+  fs::path Find(const std::string& name, const std::string& file, int line) const {
     if (!folder_.empty()) {
       fs::path p = FindImageFile(folder_, name);
-      if (p.empty()) throw lines.Fail("no image for '" + name + "' in " + folder_.string());
+      if (p.empty())
+        throw InputError(file, line, "no image for '" + name + "' in " + folder_.string());
       return p;
     }
     auto it = by_stem_.find(name);
     if (it == by_stem_.end()) it = by_stem_.find(fs::path(name).stem().string());
-    if (it == by_stem_.end()) throw lines.Fail("image '" + name + "' is not in the images list");
+    if (it == by_stem_.end())
+      throw InputError(file, line, "image '" + name + "' is not in the images list");
     return it->second;
   }
 
@@ -182,6 +188,55 @@ class ImageLocator {
   fs::path folder_;
   std::map<std::string, fs::path> by_stem_;
 };
+
+// A value parsed by `fn` (which throws sapmvs::Error); its errors point at
+// the value's line.
+template <typename Fn>
+auto ParseValue(const YamlFile& f, const YAML::Node& node, Fn fn) {
+  const std::string text = f.As<std::string>(node, "a string");
+  try {
+    return fn(text);
+  } catch (const InputError&) {
+    throw;
+  } catch (const Error& e) {
+    f.Fail(node, e.what());
+  }
+}
+
+// Metashape and Pix4D fix the angles' order and unit: keys saying otherwise
+// contradict the file instead of choosing for it.
+void CheckExportKeys(const YamlFile& f, const YAML::Node& ori, const std::string& what) {
+  const std::string fixed = "the orientation is " + what + " (omega-phi-kappa in degrees)";
+  if (ori["type"] && f.As<std::string>(ori["type"], "a type") != "angles")
+    f.Fail(ori["type"], fixed + ": expected type: angles, or no type");
+  if (ori["angles"] && ParseValue(f, ori["angles"], ParseAngleOrder) != AngleOrder::kOmegaPhiKappa)
+    f.Fail(ori["angles"], fixed + ": expected angles: omega-phi-kappa, or no angles");
+  if (ori["units"] && ParseValue(f, ori["units"], ParseAngleUnit) != AngleUnit::kDegree)
+    f.Fail(ori["units"], fixed + ": expected units: deg, or no units");
+}
+
+// The cameras of a Metashape or Pix4D export, all with the block's one camera.
+void AddExportedImages(const YamlFile& f, const YAML::Node& ori, OrientationFormat format,
+                       const fs::path& file, const Intrinsics* camera,
+                       const std::string& camera_name, const ImageLocator& images, Block* block) {
+  const std::string what =
+      format == OrientationFormat::kMetashape ? "a Metashape export" : "a Pix4D export";
+  CheckExportKeys(f, ori, what);
+  if (camera == nullptr) {
+    f.Fail(ori, file.filename().string() + " is " + what +
+                    ", which names no camera per image: expected one camera in block.yaml");
+  }
+  const std::vector<ExportedPose> poses =
+      format == OrientationFormat::kMetashape ? ReadMetashapeOpk(file) : ReadPix4dExternal(file);
+  for (const ExportedPose& pose : poses) {
+    BlockImage im;
+    im.name = pose.name;
+    im.camera_name = camera_name;
+    im.path = images.Find(pose.name, file.string(), pose.line);
+    im.camera = Camera::FromCameraToWorld(*camera, pose.center, pose.camera_to_world);
+    block->images.push_back(std::move(im));
+  }
+}
 
 }  // namespace
 
@@ -236,17 +291,16 @@ Block ReadYamlBlock(const fs::path& given, const BlockReadOptions& options) {
   bool camera_to_world = true;
   size_t numbers = 6;
   std::string layout = "name X Y Z a1 a2 a3";
-  // Value errors point at the offending value's line.
-  auto parse = [&f](const YAML::Node& node, auto fn) {
-    const std::string text = f.As<std::string>(node, "a string");
-    try {
-      return fn(text);
-    } catch (const InputError&) {
-      throw;
-    } catch (const Error& e) {
-      f.Fail(node, e.what());
-    }
-  };
+  auto parse = [&f](const YAML::Node& node, auto fn) { return ParseValue(f, node, fn); };
+  OrientationFormat format =
+      ori["format"] ? parse(ori["format"], ParseOrientationFormat) : OrientationFormat::kAuto;
+  if (format == OrientationFormat::kAuto) format = DetectOrientationFormat(ori_file);
+  if (format == OrientationFormat::kMetashape || format == OrientationFormat::kPix4d) {
+    const auto cam = cameras.find(single_camera);
+    AddExportedImages(f, ori, format, ori_file, cam == cameras.end() ? nullptr : &cam->second,
+                      single_camera, images, &block);
+    return block;
+  }
   if (type == "angles") {
     order = parse(f.Required(ori, "angles", "orientation"), ParseAngleOrder);
     unit = parse(f.Required(ori, "units", "orientation"), ParseAngleUnit);
@@ -283,7 +337,7 @@ Block ReadYamlBlock(const fs::path& given, const BlockReadOptions& options) {
     const auto cam = cameras.find(im.camera_name);
     if (cam == cameras.end()) throw lines.Fail("unknown camera '" + im.camera_name + "'");
     if (block.FindImage(im.name) >= 0) throw lines.Fail("image '" + im.name + "' listed twice");
-    im.path = images.Find(im.name, lines);
+    im.path = images.Find(im.name, lines.file(), lines.line());
     try {
       const Eigen::Vector3d c(v[0], v[1], v[2]);
       if (type == "angles") {

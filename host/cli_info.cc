@@ -31,7 +31,12 @@ std::string Fmt(const char* fmt, double a, double b = 0, double c = 0) {
 void PrintInfo(const Block& block, std::ostream& out) {
   const BlockGeometry g = EstimateBlockGeometry(block);
   out << "block          " << block.source.string() << " (" << block.format << ")\n";
-  out << "frame          " << (block.crs.empty() ? block.frame_note : "CRS " + block.crs) << "\n";
+  // A CRS the reader derived (OpenSfM's reference point) comes with how.
+  out << "frame          "
+      << (block.crs.empty()          ? block.frame_note
+          : block.frame_note.empty() ? "CRS " + block.crs
+                                     : "CRS " + block.crs + " (" + block.frame_note + ")")
+      << "\n";
   out << "local origin   "
       << Fmt("X %.3f  Y %.3f  Z %.3f", block.origin.x(), block.origin.y(), block.origin.z())
       << "\n";

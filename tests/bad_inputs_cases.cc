@@ -42,6 +42,27 @@ std::function<void(const fs::path&)> OpenSfm(const std::string& from, const std:
   };
 }
 
+std::function<void(const fs::path&)> Metashape(const std::string& from, const std::string& to) {
+  return [=](const fs::path& d) {
+    WriteMetashapeFixture(d);
+    ReplaceInFile(d / "cameras.txt", from, to);
+  };
+}
+
+std::function<void(const fs::path&)> Pix4d(const std::string& from, const std::string& to) {
+  return [=](const fs::path& d) {
+    WritePix4dFixture(d);
+    ReplaceInFile(d / kPix4dFixtureFile, from, to);
+  };
+}
+
+std::function<void(const fs::path&)> OpenSfmLla(const std::string& from, const std::string& to) {
+  return [=](const fs::path& d) {
+    WriteOpenSfmLlaFixture(d);
+    ReplaceInFile(d / "reference_lla.json", from, to);
+  };
+}
+
 std::function<void(const fs::path&)> Pmvs(const std::string& from, const std::string& to) {
   return [=](const fs::path& d) {
     WritePmvsFixture(d);
@@ -156,6 +177,42 @@ std::vector<BadInputCase> BadInputCases() {
        },
        kInfo},
 
+      // Metashape and Pix4D exports (block.yaml's orientation)
+      {"MetashapeColumns", "cameras.txt (Metashape)", "a line with 15 fields",
+       Metashape("b.png\t3\t0\t100\t0\t0\t0\t1", "b.png\t3\t0\t100\t0\t0\t1"), kInfo},
+      {"MetashapeNotANumber", "cameras.txt (Metashape)", "a letter O for a zero",
+       Metashape("b.png\t3\t0", "b.png\t3\tO"), kInfo},
+      {"MetashapeImageTwice", "cameras.txt (Metashape)", "image a.png listed twice",
+       Metashape("b.png\t3", "a.png\t3"), kInfo},
+      {"MetashapeImageMissing", "cameras.txt (Metashape)", "image c.png has no file",
+       Metashape("b.png\t3", "c.png\t3"), kInfo},
+      {"MetashapeMatrixMismatch", "cameras.txt (Metashape)", "kappa 90 with r11..r33 of kappa 0",
+       Metashape("b.png\t3\t0\t100\t0\t0\t0", "b.png\t3\t0\t100\t0\t0\t90"), kInfo},
+      {"Pix4dColumns", "p_calibrated_external_camera_parameters.txt", "a line with 6 fields",
+       Pix4d("b.png 3 0 100 0 0 0", "b.png 3 0 100 0 0"), kInfo},
+      {"Pix4dNotANumber", "p_calibrated_external_camera_parameters.txt", "a letter O for a zero",
+       Pix4d("b.png 3 0", "b.png 3 O"), kInfo},
+      {"Pix4dImageTwice", "p_calibrated_external_camera_parameters.txt", "image a.png listed twice",
+       Pix4d("b.png 3", "a.png 3"), kInfo},
+      {"Pix4dImageMissing", "p_calibrated_external_camera_parameters.txt",
+       "image c.png has no file", Pix4d("b.png 3", "c.png 3"), kInfo},
+      {"Pix4dWgs84", "p_calibrated_external_camera_parameters_wgs84.txt",
+       "Pix4D's latitude/longitude export",
+       [](const fs::path& d) {
+         WritePix4dFixture(d);
+         ReplaceInFile(d / "block.yaml", "parameters.txt", "parameters_wgs84.txt");
+         WriteText(d / "p_calibrated_external_camera_parameters_wgs84.txt",
+                   "imageName latitude longitude altitude omega phi kappa\n"
+                   "a.png 47.0 8.0 500 0 0 0\n");
+       },
+       kInfo},
+      {"YamlExportUnits", "block.yaml", "units: gon for a Metashape export",
+       [](const fs::path& d) {
+         WriteMetashapeFixture(d);
+         ReplaceInFile(d / "block.yaml", "format: metashape", "format: metashape\n  units: gon");
+       },
+       kInfo},
+
       // COLMAP
       {"ColmapImageTwice", "sparse/images.txt", "a.png listed twice",
        Colmap("images.txt", "1 b.png", "1 a.png"), "info {D}"},
@@ -207,6 +264,15 @@ std::vector<BadInputCase> BadInputCases() {
                "\"camera\": \"cam2\",\n        \"rotation\": [3.14159265358979, 0, 0],\n"
                "        \"translation\": [-3"),
        "info {D}"},
+
+      {"OpenSfmLlaMissingKey", "reference_lla.json", "no altitude",
+       OpenSfmLla(",\n  \"altitude\": 400.0", ""), "info {D}"},
+      {"OpenSfmLlaNotANumber", "reference_lla.json", "latitude \"47.0\", a string",
+       OpenSfmLla("47.0", "\"47.0\""), "info {D}"},
+      {"OpenSfmLlaLatitude", "reference_lla.json", "latitude 91", OpenSfmLla("47.0", "91.0"),
+       "info {D}"},
+      {"OpenSfmLlaPolar", "reference_lla.json", "latitude 86, outside the UTM zones",
+       OpenSfmLla("47.0", "86.0"), "info {D}"},
 
       // PMVS
       {"PmvsNegativeFocal", "txt/00000000.txt", "fx = -1000 in P, 00000001.txt right",

@@ -82,6 +82,43 @@ void WriteYamlFixture(const fs::path& dir, const std::string& ext) {
   WriteFixtureImage(dir / "images" / ("b" + ext));
 }
 
+namespace {
+// block.yaml of the yaml fixture with `orientation` replaced by `orientation`.
+void WriteExportBlockYaml(const fs::path& dir, const std::string& orientation) {
+  WriteText(dir / "block.yaml",
+            "ground_height: 0\n"
+            "camera:\n"
+            "  width: 96\n"
+            "  height: 72\n"
+            "  focal_mm: 10\n"
+            "  pixel_um: 10\n"
+            "images: images/\n"
+            "orientation:\n" +
+                orientation);
+}
+}  // namespace
+
+void WriteMetashapeFixture(const fs::path& dir) {
+  WriteYamlFixture(dir);
+  fs::remove(dir / "orientation.txt");
+  WriteExportBlockYaml(dir, "  file: cameras.txt\n  format: metashape\n");
+  WriteText(dir / "cameras.txt",
+            "# Cameras (2)\n"
+            "# PhotoID, X, Y, Z, Omega, Phi, Kappa, r11, r12, r13, r21, r22, r23, r31, r32, r33\n"
+            "a.png\t0\t0\t100\t0\t0\t0\t1\t0\t0\t0\t1\t0\t0\t0\t1\n"
+            "b.png\t3\t0\t100\t0\t0\t0\t1\t0\t0\t0\t1\t0\t0\t0\t1\n");
+}
+
+void WritePix4dFixture(const fs::path& dir) {
+  WriteYamlFixture(dir);
+  fs::remove(dir / "orientation.txt");
+  WriteExportBlockYaml(dir, std::string("  file: ") + kPix4dFixtureFile + "\n");
+  WriteText(dir / kPix4dFixtureFile,
+            "imageName X Y Z Omega Phi Kappa \n"
+            "a.png 0 0 100 0 0 0\n"
+            "b.png 3 0 100 0 0 0\n");
+}
+
 void WriteColmapFixture(const fs::path& dir) {
   WriteText(dir / "sparse" / "cameras.txt", "1 PINHOLE 96 72 1000 1000 48 36\n");
   // Looking down (x_cam = R X + t with R = diag(1, -1, -1)) from Z = 100.
@@ -137,6 +174,16 @@ void WriteOpenSfmFixture(const fs::path& dir) {
             "]\n");
   WriteFixtureImage(dir / "images" / "a.png");
   WriteFixtureImage(dir / "images" / "b.png");
+}
+
+void WriteOpenSfmLlaFixture(const fs::path& dir) {
+  WriteOpenSfmFixture(dir);
+  WriteText(dir / "reference_lla.json",
+            "{\n"
+            "  \"latitude\": 47.0,\n"
+            "  \"longitude\": 8.0,\n"
+            "  \"altitude\": 400.0\n"
+            "}\n");
 }
 
 void WritePmvsFixture(const fs::path& dir) {

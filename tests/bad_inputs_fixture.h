@@ -16,12 +16,21 @@ constexpr int kFixtureHeight = 72;
 
 // DIR/block.yaml, DIR/orientation.txt (images a, b), DIR/images/{a,b}.EXT.
 void WriteYamlFixture(const std::filesystem::path& dir, const std::string& ext = ".png");
+// The yaml fixture with its orientation as Metashape exports it:
+// DIR/cameras.txt (`format: metashape`, tabs, r11..r33), no orientation.txt.
+void WriteMetashapeFixture(const std::filesystem::path& dir);
+// The yaml fixture with its orientation as Pix4D exports it (detected):
+// DIR/p_calibrated_external_camera_parameters.txt, no orientation.txt.
+void WritePix4dFixture(const std::filesystem::path& dir);
+constexpr const char* kPix4dFixtureFile = "p_calibrated_external_camera_parameters.txt";
 // DIR/sparse/{cameras,images}.txt, DIR/images/{a,b}.png.
 void WriteColmapFixture(const std::filesystem::path& dir);
 // DIR/cams/{a,b}.png.camera, DIR/images/{a,b}.png.
 void WriteStrechaFixture(const std::filesystem::path& dir);
 // DIR/reconstruction.json (shots a.png, b.png), DIR/images/{a,b}.png.
 void WriteOpenSfmFixture(const std::filesystem::path& dir);
+// The OpenSfM fixture georeferenced by DIR/reference_lla.json (47 N, 8 E).
+void WriteOpenSfmLlaFixture(const std::filesystem::path& dir);
 // DIR/txt/0000000{0,1}.txt, DIR/visualize/0000000{0,1}.png.
 void WritePmvsFixture(const std::filesystem::path& dir);
 // DIR/cloud.xyz (a few points) and DIR/lidar.xyz (a 20 x 20 grid, spacing 1).

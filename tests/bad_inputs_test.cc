@@ -151,9 +151,13 @@ TEST(BadInputsDoc, UnbrokenFixturesAreRead) {
   WriteStrechaFixture(dir / "strecha");
   WriteOpenSfmFixture(dir / "opensfm");
   WritePmvsFixture(dir / "pmvs");
+  WriteMetashapeFixture(dir / "metashape");
+  WritePix4dFixture(dir / "pix4d");
+  WriteOpenSfmLlaFixture(dir / "opensfm_lla");
   for (const fs::path& block :
        {dir / "yaml" / "block.yaml", dir / "jpeg" / "block.yaml", dir / "colmap",
-        dir / "strecha" / "cams", dir / "opensfm", dir / "pmvs"}) {
+        dir / "strecha" / "cams", dir / "opensfm", dir / "pmvs", dir / "metashape" / "block.yaml",
+        dir / "pix4d" / "block.yaml", dir / "opensfm_lla"}) {
     const CliResult r = RunCli("info " + block.string() + " --ground-height 0");
     EXPECT_EQ(r.exit_code, 0) << block << "\n" << r.err;
     EXPECT_EQ(r.err, "") << block;

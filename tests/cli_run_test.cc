@@ -14,7 +14,9 @@
 #include "cli_test_util.h"
 #include "sapmvs/cloud_merge.h"
 #include "sapmvs/error.h"
+#include "sapmvs/las_io.h"
 #include "sapmvs/ply_io.h"
+#include "sapmvs/raster_io.h"
 #include "test_util.h"
 
 namespace sapmvs {
@@ -148,6 +150,25 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
                                           "groups/group_001.ply",
                                           "groups/group_001.json"};
   EXPECT_EQ(files, expected);
+}
+
+// An ODM project (reference_lla, no CRS of its own) comes out in UTM 51N:
+// `info` says so, and cloud.las, dsm.tif and report.json carry EPSG:32651.
+TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {
+  const fs::path odm = test::SharedDir() / "datasets/orthority_ngi_odm/odm";
+  SAPMVS_REQUIRE_PATH(odm / "opensfm/reconstruction.json");
+  const auto info = RunCli("info " + odm.string() + " --ground-height 98");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("frame          CRS EPSG:32651 ("), std::string::npos) << info.out;
+  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  const auto r = RunCli("run " + odm.string() + " --ground-height 98 --level 2 --out " +
+                        out_.string() + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const GeoRaster dsm = ReadGeoRaster(out_ / "dsm.tif");
+  EXPECT_EQ(dsm.crs, CrsToWkt("EPSG:32651"));
+  EXPECT_EQ(ReadLas(out_ / "cloud.las").crs_wkt, CrsToWkt("EPSG:32651"));
+  std::ifstream report(out_ / "report.json");
+  EXPECT_EQ(nlohmann::json::parse(report).value("crs", ""), "EPSG:32651");
 }
 
 TEST_F(CliRunTest, MinImageNumTwoIsAccepted) {
