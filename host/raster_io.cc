@@ -11,6 +11,7 @@
 #include <memory>
 #include <sstream>
 
+#include "gdal_messages.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 
@@ -19,11 +20,12 @@ namespace {
 
 // GDAL reports failures through a handler that prints to stderr. While one of
 // our calls runs, the message is kept quiet and folded into the exception
-// instead, so the user sees it once, in our one-line format.
+// instead, so the user sees it once, in our one-line format; warnings become
+// detail lines (gdal_messages.h).
 class QuietGdalErrors {
  public:
   QuietGdalErrors() {
-    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLPushErrorHandler(GdalMessageHandler);
     CPLErrorReset();
   }
   ~QuietGdalErrors() { CPLPopErrorHandler(); }
