@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <sstream>
 
@@ -124,6 +125,26 @@ std::string CrsToWkt(const std::string& crs) {
     throw Error("CRS '" + crs + "': cannot be written as WKT" + quiet.Detail());
   }
   return out;
+}
+
+CrsIdentity IdentifyCrs(const std::string& crs) {
+  QuietGdalErrors quiet;
+  OGRSpatialReference srs;
+  const char* const options[] = {"ALLOW_NETWORK_ACCESS=NO", nullptr};
+  if (crs.empty() || srs.SetFromUserInput(crs.c_str(), options) != OGRERR_NONE) {
+    throw Error("CRS '" + crs + "': expected WKT, EPSG:n or a PROJ string" + quiet.Detail());
+  }
+  CrsIdentity id;
+  if (const char* name = srs.GetName()) id.name = name;
+  // A WKT without an AUTHORITY node may still be an EPSG CRS by content.
+  const char* authority = srs.GetAuthorityName(nullptr);
+  if (!(authority && EQUAL(authority, "EPSG"))) {
+    srs.AutoIdentifyEPSG();
+    authority = srs.GetAuthorityName(nullptr);
+  }
+  const char* code = srs.GetAuthorityCode(nullptr);
+  if (authority && EQUAL(authority, "EPSG") && code) id.epsg = std::atoi(code);
+  return id;
 }
 
 void WriteGeoTiff(const std::filesystem::path& path, const GeoRaster& raster) {
