@@ -6,20 +6,41 @@
 
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "sapmvs/block.h"
 #include "sapmvs/block_reader.h"
+#include "sapmvs/log.h"
 
 namespace CLI {
 class App;
-}
+class ParseError;
+}  // namespace CLI
 
 namespace sapmvs::cli {
 
-// Global flags shared by all subcommands.
+// Global flags shared by all subcommands; they may come before or after the
+// subcommand. Applied once (ApplyGlobalFlags) before any subcommand's work.
 struct GlobalFlags {
-  bool quiet = false;  // No progress output, even on a terminal.
+  bool quiet = false;  // -q: no progress output, even on a terminal.
+  // --threads: host threads (OpenMP, OpenCV) and PoCL's CPU device; 0 = all
+  // cores (thread_count.h).
+  int threads = 0;
+  LogOptions log;  // -v (verbosity, counted), --log FILE
+  // Not a flag: argv as main() got it, for the log and report.json.
+  std::vector<std::string> command_line;
 };
+// Adds -q, -v, --threads and --log to the top-level command.
+void AddGlobalFlags(CLI::App& app, GlobalFlags* flags);
+// Sets the thread count and starts the log (log.h) with the command line as
+// its first line; throws Error for a bad value or a log file that cannot be
+// opened. Called once, after parsing and before any subcommand's work.
+void ApplyGlobalFlags(const GlobalFlags& flags);
+
+// A CLI11 parse error (unknown flag, bad value, missing subcommand, ...) as
+// one line without the "sapmvs: " prefix, naming the flag or value and the
+// subcommand's --help.
+std::string DescribeParseError(const CLI::App& app, const CLI::ParseError& error);
 
 // How a subcommand reads its BLOCK argument: --format, --image-dir,
 // --no-size-check, --ground-height, the same for every subcommand.

@@ -163,6 +163,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
         o->matcher.mode = ParseMatchMode(*mode);
         o->matcher.use_edges = !*no_edges;
         o->matcher.progress = !global.quiet;
+        o->command_line = global.command_line;
         if (o->profile && !profile->empty()) CheckProfilePath(*profile, o->out);
         const RunReport report = RunDense(*o);
         PrintRunSummary(report, std::cout);

@@ -19,6 +19,7 @@
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
 #include "sapmvs/las_io.h"
+#include "sapmvs/log.h"
 #include "sapmvs/memory_use.h"
 #include "sapmvs/output_folder.h"
 #include "sapmvs/ply_io.h"
@@ -67,6 +68,12 @@ namespace {
 
 double Since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string Seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f s", s);
+  return buf;
 }
 
 void AddStats(const MatchStats& s, MatchStats* sum) {
@@ -142,9 +149,11 @@ RunReport RunDense(const RunOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   RunReport report;
   report.out = options.out;
+  report.start_time = std::chrono::system_clock::now();
   auto stage_start = start;
   auto end_stage = [&](const std::string& name) {
     report.stages.emplace_back(name, Since(stage_start));
+    LogDetail("run: " + name + " " + Seconds(report.stages.back().second));
     stage_start = std::chrono::steady_clock::now();
   };
 
@@ -171,6 +180,11 @@ RunReport RunDense(const RunOptions& options) {
   device_options.profile = options.profile;
   ClContext context(device_options);
   report.device = context.device().Describe();
+  report.device_info = {
+      context.device().name, context.device().vendor,
+      context.device().platform_name + " (" + context.device().platform_version + ")",
+      DeviceTypeName(context.device().type)};
+  LogDetail("device: " + report.device);
 
   const OutputFolder folder(options.out, "run", {"groups"});
   if (options.restart) RemoveRunOutputs(options.out);
@@ -206,7 +220,12 @@ RunReport RunDense(const RunOptions& options) {
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
     AddStats(result.stats, &report.stats);
-    checkpoints.Write(g, result.cloud, run.seconds, result.stats);
+    for (const auto& [name, t] : result.stats.stages) {
+      LogDetail("group " + std::to_string(g + 1) + "/" + std::to_string(n) + ": " + name + " " +
+                Seconds(t.wall) +
+                (options.profile ? ", " + Seconds(t.device) + " in kernels" : ""));
+    }
+    checkpoints.Write(g, result.cloud, run.seconds, result.stats, options.profile);
     ++matched_now;
     report.groups.push_back(run);
   }
@@ -238,6 +257,11 @@ RunReport RunDense(const RunOptions& options) {
                 "written (check the orientation, or lower --threshold)");
   }
   report.points = static_cast<long>(merged.points.size());
+  report.bounds_min = report.bounds_max = merged.points.front().position;
+  for (const CloudPoint& p : merged.points) {
+    report.bounds_min = report.bounds_min.cwiseMin(p.position);
+    report.bounds_max = report.bounds_max.cwiseMax(p.position);
+  }
   report.mean_spacing = MeanPointSpacing(merged);
   const GeoRaster dsm = RasterizeDsm(merged, options.dsm, &report.dsm_cell);
   const CloudFootprint fp = MeasureFootprint(merged, report.dsm_cell);
@@ -255,6 +279,7 @@ RunReport RunDense(const RunOptions& options) {
   report.finished = true;
   report.total_seconds = Since(start);
   report.peak_rss_bytes = PeakRssBytes();
+  report.end_time = std::chrono::system_clock::now();
   WriteRunReport(options, report, block, plan);
   return report;
 }

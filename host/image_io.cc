@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "gdal_messages.h"
 #include "input_file.h"
 #include "sapmvs/error.h"
 
@@ -22,8 +23,9 @@ void RegisterGdalOnce() {
   std::call_once(once, [] {
     GDALAllRegister();
     // Readers probe files that may not be rasters; the error text reaches the
-    // user through our own messages instead of GDAL's stderr handler.
-    CPLSetErrorHandler(CPLQuietErrorHandler);
+    // user through our own messages instead of GDAL's stderr handler, and
+    // GDAL's warnings as detail lines (-v).
+    InstallGdalMessageHandler();
   });
 }
 

@@ -1,21 +1,36 @@
 // The `sapmvs` command line. Only subcommands that work are registered.
+//
+// Exit codes: 0 success (and --help, --version); 1 bad input, bad flags
+// included; 2 no OpenCL platform or device (sapmvs/error.h). Every failure is
+// one line on stderr that begins "sapmvs: ".
 
 #include <CLI/CLI.hpp>
 
 #include <exception>
 #include <iostream>
 
+#include "build_info.h"
 #include "cli.h"
+#include "gdal_messages.h"
 #include "sapmvs/error.h"
+#include "sapmvs/log.h"
 
 int main(int argc, char** argv) {
+  // Before anything can reach GDAL: its warnings are detail lines, its
+  // failures part of our own messages.
+  sapmvs::InstallGdalMessageHandler();
   CLI::App app{"sapmvs: dense image matching (IG-SAPMVS) for UAV and aerial blocks on OpenCL"};
-  app.set_version_flag("--version", std::string(SAPMVS_VERSION));
+  app.set_version_flag("--version", std::string("sapmvs ") + sapmvs::BuildVersion() + " (commit " +
+                                        sapmvs::BuildCommit() + ")");
   app.require_subcommand(1);
   // Global flags such as --quiet may also follow the subcommand.
   app.fallthrough();
   sapmvs::cli::GlobalFlags global;
-  app.add_flag("-q,--quiet", global.quiet, "No progress output");
+  global.command_line.assign(argv, argv + argc);
+  sapmvs::cli::AddGlobalFlags(app, &global);
+  // Runs after the whole command line is parsed and checked, before the
+  // subcommand's callback does any work.
+  app.parse_complete_callback([&global] { sapmvs::cli::ApplyGlobalFlags(global); });
 
   sapmvs::cli::RegisterDevicesCommand(app, global);
   sapmvs::cli::RegisterInfoCommand(app, global);
@@ -25,16 +40,21 @@ int main(int argc, char** argv) {
   sapmvs::cli::RegisterEvaluateCommand(app, global);
   sapmvs::cli::RegisterExportCommand(app, global);
 
+  int code = 0;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version arrive as "errors" with exit code 0.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "sapmvs: " << sapmvs::cli::DescribeParseError(app, e) << "\n";
+    code = 1;
   } catch (const sapmvs::Error& e) {
     std::cerr << "sapmvs: " << e.what() << "\n";
-    return e.ExitCode();
+    code = e.ExitCode();
   } catch (const std::exception& e) {
     std::cerr << "sapmvs: " << e.what() << "\n";
-    return 1;
+    code = 1;
   }
-  return 0;
+  sapmvs::EndLog(code);
+  return code;
 }

@@ -8,9 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <sstream>
 
+#include "gdal_messages.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 
@@ -19,11 +21,12 @@ namespace {
 
 // GDAL reports failures through a handler that prints to stderr. While one of
 // our calls runs, the message is kept quiet and folded into the exception
-// instead, so the user sees it once, in our one-line format.
+// instead, so the user sees it once, in our one-line format; warnings become
+// detail lines (gdal_messages.h).
 class QuietGdalErrors {
  public:
   QuietGdalErrors() {
-    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLPushErrorHandler(GdalMessageHandler);
     CPLErrorReset();
   }
   ~QuietGdalErrors() { CPLPopErrorHandler(); }
@@ -122,6 +125,26 @@ std::string CrsToWkt(const std::string& crs) {
     throw Error("CRS '" + crs + "': cannot be written as WKT" + quiet.Detail());
   }
   return out;
+}
+
+CrsIdentity IdentifyCrs(const std::string& crs) {
+  QuietGdalErrors quiet;
+  OGRSpatialReference srs;
+  const char* const options[] = {"ALLOW_NETWORK_ACCESS=NO", nullptr};
+  if (crs.empty() || srs.SetFromUserInput(crs.c_str(), options) != OGRERR_NONE) {
+    throw Error("CRS '" + crs + "': expected WKT, EPSG:n or a PROJ string" + quiet.Detail());
+  }
+  CrsIdentity id;
+  if (const char* name = srs.GetName()) id.name = name;
+  // A WKT without an AUTHORITY node may still be an EPSG CRS by content.
+  const char* authority = srs.GetAuthorityName(nullptr);
+  if (!(authority && EQUAL(authority, "EPSG"))) {
+    srs.AutoIdentifyEPSG();
+    authority = srs.GetAuthorityName(nullptr);
+  }
+  const char* code = srs.GetAuthorityCode(nullptr);
+  if (authority && EQUAL(authority, "EPSG") && code) id.epsg = std::atoi(code);
+  return id;
 }
 
 void WriteGeoTiff(const std::filesystem::path& path, const GeoRaster& raster) {

@@ -120,9 +120,9 @@ GroupCheckpoint RunCheckpoints::Read(int group) const {
 }
 
 void RunCheckpoints::Write(int group, const PointCloud& cloud, double seconds,
-                           const MatchStats& stats) {
+                           const MatchStats& stats, bool device_times) {
   WritePly(CloudPath(group), cloud);
-  nlohmann::json j = MatchStatsJson(stats);
+  nlohmann::json j = MatchStatsJson(stats, device_times);
   j["status"] = "done";
   j["group"] = group + 1;
   j["points"] = static_cast<long>(cloud.points.size());

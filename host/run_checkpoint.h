@@ -36,7 +36,9 @@ class RunCheckpoints {
 
   bool Done(int group) const;
   GroupCheckpoint Read(int group) const;
-  void Write(int group, const PointCloud& cloud, double seconds, const MatchStats& stats);
+  // `device_times`: the stats hold measured kernel times (--profile).
+  void Write(int group, const PointCloud& cloud, double seconds, const MatchStats& stats,
+             bool device_times);
   std::filesystem::path CloudPath(int group) const;
   std::filesystem::path StatusPath(int group) const;
 

@@ -3,8 +3,13 @@
 #include <fstream>
 #include <iomanip>
 
+#include "build_info.h"
+#include "machine_info.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
+#include "sapmvs/log.h"
+#include "sapmvs/raster_io.h"
+#include "sapmvs/thread_count.h"
 
 namespace sapmvs {
 
@@ -42,7 +47,7 @@ nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
           {"min_cluster_size", m.min_cluster_size}};
 }
 
-nlohmann::json MatchStatsJson(const MatchStats& s) {
+nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   nlohmann::json j;
   j["images"] = s.images;
   j["features"] = s.features;
@@ -66,29 +71,64 @@ nlohmann::json MatchStatsJson(const MatchStats& s) {
                  {"points", s.points}};
   nlohmann::json stages = nlohmann::json::array();
   for (const auto& [name, t] : s.stages) {
-    stages.push_back({{"stage", name}, {"wall_seconds", t.wall}, {"device_seconds", t.device}});
+    nlohmann::json stage = {{"stage", name}, {"wall_seconds", t.wall}};
+    if (device_times) stage["device_seconds"] = t.device;
+    stages.push_back(stage);
   }
   j["stages"] = stages;
   nlohmann::json kernels = nlohmann::json::array();
   for (const auto& [name, t] : s.kernels) {
-    kernels.push_back({{"kernel", name},
-                       {"launches", t.launches},
-                       {"items", t.items},
-                       {"device_seconds", t.seconds}});
+    nlohmann::json kernel = {{"kernel", name}, {"launches", t.launches}, {"items", t.items}};
+    if (device_times) kernel["device_seconds"] = t.seconds;
+    kernels.push_back(kernel);
   }
   j["kernels"] = kernels;
   j["gsd_at_level"] = s.gsd;
   return j;
 }
 
+namespace {
+
+nlohmann::json CrsJson(const std::string& crs) {
+  if (crs.empty()) return nullptr;
+  const CrsIdentity id = IdentifyCrs(crs);
+  return {{"epsg", id.epsg > 0 ? nlohmann::json(id.epsg) : nlohmann::json(nullptr)},
+          {"name", id.name},
+          {"definition", crs}};
+}
+
+nlohmann::json MachineJson() {
+  const MachineInfo m = DescribeMachine();
+  return {{"hostname", m.hostname},
+          {"cpu", m.cpu_model},
+          {"cores", m.cores},
+          {"memory_bytes", m.memory_bytes},
+          {"threads", HostThreadCount()}};
+}
+
+nlohmann::json Xyz(const Eigen::Vector3d& v) { return {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
+
+}  // namespace
+
 void WriteRunReport(const RunOptions& options, const RunReport& report, const Block& block,
                     const GroupingPlan& plan) {
   nlohmann::json j;
+  j["report_version"] = kRunReportVersion;
+  j["sapmvs"] = {{"version", BuildVersion()}, {"commit", BuildCommit()}};
+  j["command_line"] = options.command_line;
+  j["start_time"] = Iso8601Utc(report.start_time);
+  j["end_time"] = Iso8601Utc(report.end_time);
+  j["machine"] = MachineJson();
   j["block"] = options.block.string();
   j["mode"] = ToString(options.matcher.mode);
   j["level"] = options.matcher.level;
-  j["device"] = report.device;
-  j["crs"] = block.crs;
+  j["device"] = {{"description", report.device},
+                 {"name", report.device_info.name},
+                 {"vendor", report.device_info.vendor},
+                 {"platform", report.device_info.platform},
+                 {"type", report.device_info.type}};
+  j["crs"] = CrsJson(block.crs);
+  j["bounds"] = {{"min", Xyz(report.bounds_min)}, {"max", Xyz(report.bounds_max)}};
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["images"] = report.images;
   j["points"] = report.points;
@@ -126,7 +166,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
                 {"cross_group_duplicates", report.merge.duplicates}};
   // Matching stages (summed over the groups matched in this call, with their
   // device time), then the run's own: plan, match (all groups), merge, ...
-  nlohmann::json matching = MatchStatsJson(report.stats);
+  nlohmann::json matching = MatchStatsJson(report.stats, options.profile);
   nlohmann::json stages = matching["stages"];
   for (const auto& [name, t] : report.stages) {
     stages.push_back({{"stage", "run " + name}, {"wall_seconds", t}, {"hms", FormatHms(t)}});

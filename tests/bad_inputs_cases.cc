@@ -138,6 +138,14 @@ std::vector<BadInputCase> BadInputCases() {
       {"EmptyFolder", "block path", "a folder without a block", [](const fs::path&) {}, "info {D}"},
       {"UnknownFormatFlag", "`--format foo`", "not a format", YamlAsIs,
        "info {D}/block.yaml --format foo"},
+      // the command line: refused before the block is read
+      {"LevelNotAnInteger", "`run --level abc`", "not an integer", YamlAsIs,
+       "run {D}/block.yaml --out {D}/out --level abc"},
+      {"UnknownFlag", "`info --colour`", "no such flag", YamlAsIs, "info {D}/block.yaml --colour"},
+      {"ThreadsNegative", "`--threads -1`", "a negative thread count", YamlAsIs,
+       "--threads -1 info {D}/block.yaml"},
+      {"LogFolderMissing", "`--log no/run.log`", "the log's folder does not exist", YamlAsIs,
+       "info {D}/block.yaml --log {D}/no/run.log"},
 
       // images
       {"ImageZeroBytes", "images/a.png", "0 bytes",

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -84,6 +85,61 @@ TEST(CliRunHelp, ShowsSectionsAndExamples) {
   EXPECT_NE(r.out.find("Examples:\n  sapmvs run block.yaml --out"), std::string::npos) << r.out;
 }
 
+// report.json's provenance, machine, device, CRS and bounds, against the
+// cloud the run wrote.
+void ExpectRunProvenance(const nlohmann::json& j, const PointCloud& cloud) {
+  EXPECT_EQ(j.at("report_version"), 2);
+  EXPECT_EQ(j.at("sapmvs").at("version"), SAPMVS_VERSION);
+  const std::string commit = j.at("sapmvs").at("commit");
+  EXPECT_TRUE(commit == "unknown" || std::regex_match(commit, std::regex("[0-9a-f]{7,40}")))
+      << commit;
+  const auto& cmd = j.at("command_line");
+  ASSERT_TRUE(cmd.is_array());
+  ASSERT_GE(cmd.size(), 4u) << cmd;
+  EXPECT_EQ(fs::path(cmd.at(0).get<std::string>()).filename(), "sapmvs") << cmd;
+  EXPECT_EQ(cmd.at(1), "run") << cmd;
+  // ISO 8601 UTC; in that form text order is time order.
+  const std::regex iso(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z)");
+  const std::string start = j.at("start_time"), end = j.at("end_time");
+  EXPECT_TRUE(std::regex_match(start, iso)) << start;
+  EXPECT_TRUE(std::regex_match(end, iso)) << end;
+  EXPECT_LE(start, end);
+  const auto& m = j.at("machine");
+  EXPECT_FALSE(m.at("hostname").get<std::string>().empty());
+  EXPECT_TRUE(m.at("cpu").is_string());
+  EXPECT_GE(m.at("cores").get<int>(), 1);
+  EXPECT_GE(m.at("threads").get<int>(), 1);
+  EXPECT_GT(m.at("memory_bytes").get<double>(), 64.0 * (1 << 20));
+  const auto& d = j.at("device");
+  for (const char* key : {"name", "vendor", "platform", "type", "description"}) {
+    EXPECT_FALSE(d.at(key).get<std::string>().empty()) << key << " in " << d;
+  }
+  // The tiny block is in UTM 32N.
+  EXPECT_EQ(j.at("crs").at("epsg"), 32632) << j.at("crs");
+  EXPECT_NE(j.at("crs").at("name").get<std::string>().find("UTM zone 32N"), std::string::npos);
+  Eigen::Vector3d lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    const char* axis = a == 0 ? "x" : a == 1 ? "y" : "z";
+    lo[a] = j.at("bounds").at("min").at(axis);
+    hi[a] = j.at("bounds").at("max").at(axis);
+  }
+  Eigen::Vector3d cloud_lo = cloud.points.front().position, cloud_hi = cloud_lo;
+  for (const CloudPoint& p : cloud.points) {
+    for (int a = 0; a < 3; ++a) {
+      ASSERT_GE(p.position[a], lo[a]) << "axis " << a;
+      ASSERT_LE(p.position[a], hi[a]) << "axis " << a;
+    }
+    cloud_lo = cloud_lo.cwiseMin(p.position);
+    cloud_hi = cloud_hi.cwiseMax(p.position);
+  }
+  // Tight: the box is the cloud's, not some padded extent.
+  EXPECT_LT((cloud_lo - lo).norm(), 1e-6);
+  EXPECT_LT((cloud_hi - hi).norm(), 1e-6);
+  // Without --profile no device time was measured, and none is reported.
+  for (const auto& k : j.at("kernels")) EXPECT_FALSE(k.contains("device_seconds")) << k;
+  for (const auto& st : j.at("stages")) EXPECT_FALSE(st.contains("device_seconds")) << st;
+}
+
 TEST_F(CliRunTest, WritesCloudAndReport) {
   if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
   const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " -q");
@@ -134,6 +190,7 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
     launched = launched || kernel.at("launches").get<long>() > 0;
   }
   EXPECT_TRUE(launched) << j.at("kernels");
+  ExpectRunProvenance(j, cloud);
 
   // The outputs and one group's checkpoint, no temporary file left behind.
   std::set<std::string> files;
@@ -260,14 +317,25 @@ TEST_F(CliRunTest, ProfilePrintsKernelTablesAndWritesThem) {
   double device = 0;
   for (const auto& k : j.at("kernels")) device += k.at("seconds").get<double>();
   EXPECT_GT(device, 0) << "the queue did not profile";
-  // Without --profile the queue does not profile: no device times at all.
+  // With it, report.json has the device times it measured.
+  std::ifstream pin(out_ / "report.json");
+  const nlohmann::json profiled = nlohmann::json::parse(pin);
+  double reported = 0;
+  for (const auto& k : profiled.at("kernels")) reported += k.at("device_seconds").get<double>();
+  EXPECT_GT(reported, 0);
+  // Without --profile the queue does not profile: no device times at all,
+  // not even zeros. -v shows the stages' times as they end.
   const fs::path plain = out_ / "plain";
-  const auto p = RunCli("run " + Block().string() + " --out " + plain.string() + " -q");
+  const auto p = RunCli("run " + Block().string() + " --out " + plain.string() + " -q -v");
   ASSERT_EQ(p.exit_code, 0) << p.err;
   std::ifstream rin(plain / "report.json");
   const nlohmann::json report = nlohmann::json::parse(rin);
-  for (const auto& k : report.at("kernels")) EXPECT_EQ(k.at("device_seconds").get<double>(), 0);
+  for (const auto& k : report.at("kernels")) EXPECT_FALSE(k.contains("device_seconds")) << k;
   EXPECT_FALSE(fs::exists(plain / "profile.csv"));
+  for (const std::string line : {"device: ", "run: plan ", "group 1/1: seeds ", "run: write "}) {
+    EXPECT_NE(p.err.find(line), std::string::npos) << line << " in\n" << p.err;
+  }
+  EXPECT_EQ(p.err.find("in kernels"), std::string::npos) << p.err;
 }
 
 // Whole-block runs: the tiny block (2 strips of 2 images) split into one

@@ -237,3 +237,33 @@ TEST_F(RasterIoTest, SouthUpRastersAreFlippedToNorthUp) {
 
 }  // namespace
 }  // namespace sapmvs
+
+namespace sapmvs {
+namespace {
+
+// report.json names a CRS by EPSG code and name: from an EPSG:n, from a WKT
+// that has the code, and from one that has lost it; a custom projection has
+// a name but no code.
+TEST(IdentifyCrs, EpsgCodeAndNameWhereThereIsOne) {
+  const CrsIdentity utm = IdentifyCrs("EPSG:32632");
+  EXPECT_EQ(utm.epsg, 32632);
+  EXPECT_EQ(utm.name, "WGS 84 / UTM zone 32N");
+  EXPECT_EQ(IdentifyCrs(CrsToWkt("EPSG:2056")).epsg, 2056);
+  OGRSpatialReference bare;
+  bare.SetWellKnownGeogCS("WGS84");
+  bare.SetUTM(33, TRUE);
+  char* wkt = nullptr;
+  ASSERT_EQ(bare.exportToWkt(&wkt), OGRERR_NONE);
+  const std::string no_authority = wkt;
+  CPLFree(wkt);
+  ASSERT_EQ(bare.GetAuthorityCode(nullptr), nullptr) << no_authority;  // only its GEOGCS has one
+  EXPECT_EQ(IdentifyCrs(no_authority).epsg, 32633) << no_authority;
+  const CrsIdentity custom =
+      IdentifyCrs("+proj=tmerc +lat_0=0 +lon_0=7.3 +k=1 +x_0=0 +y_0=0 +ellps=GRS80 +units=m");
+  EXPECT_EQ(custom.epsg, 0);
+  EXPECT_THROW(IdentifyCrs("not a crs"), Error);
+  EXPECT_THROW(IdentifyCrs(""), Error);
+}
+
+}  // namespace
+}  // namespace sapmvs

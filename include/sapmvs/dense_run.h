@@ -6,11 +6,15 @@
 //   DIR/cloud.ply    binary, world coordinates in double, CRS in the header
 //   DIR/cloud.las    LAS 1.4 with RGB and the block's CRS
 //   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h), DIR/dsm.png its colour relief
-//   DIR/report.json  points, groups, per-stage wall and device times, kernel
-//                    times, the paper's statistics (Tables 4, 6, 8)
+//   DIR/report.json  provenance (version, commit, command line, times,
+//                    machine, device), CRS and bounds, points, groups,
+//                    per-stage times, kernels, the paper's statistics
+//                    (Tables 4, 6, 8); device times only with --profile
 // A killed run resumes from its last finished group; the merge always reads
 // the checkpoints back, so a resumed run writes the same cloud as one that
 // was never interrupted.
+#include <Eigen/Core>
+#include <chrono>
 #include <filesystem>
 #include <iosfwd>
 #include <string>
@@ -46,6 +50,8 @@ struct RunOptions {
   // Profile the device queue (CL_QUEUE_PROFILING_ENABLE): kernel device
   // times in the report, and the profile tables (run_profile.h).
   bool profile = false;
+  // Not an option: the command line that asked for the run, for report.json.
+  std::vector<std::string> command_line;
 
   // `grouping` with the matcher's level and min_image_num, as the plan uses it.
   GroupingOptions Grouping() const;
@@ -62,9 +68,19 @@ struct GroupRun {
   bool resumed = false;  // read from a checkpoint of an earlier call
 };
 
+// The OpenCL device a run used, as report.json names it.
+struct RunDevice {
+  std::string name;      // CL_DEVICE_NAME
+  std::string vendor;    // CL_DEVICE_VENDOR
+  std::string platform;  // CL_PLATFORM_NAME and CL_PLATFORM_VERSION
+  std::string type;      // "GPU", "CPU" or "other"
+};
+
 struct RunReport {
   std::filesystem::path out;
-  std::string device;
+  std::string device;  // one line, as `sapmvs devices` describes it
+  RunDevice device_info;
+  std::chrono::system_clock::time_point start_time, end_time;
   std::string strategy;
   bool finished = false;  // false: stopped by max_groups, outputs not written
   int images = 0;
@@ -77,6 +93,9 @@ struct RunReport {
   double density = 0;       // points per CRS unit squared of covered ground
   double area = 0;
   double dsm_cell = 0;
+  // The merged cloud's bounding box, world (CRS) coordinates.
+  Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bounds_max = Eigen::Vector3d::Zero();
   double total_seconds = 0;
   double peak_rss_bytes = 0;
   std::vector<std::pair<std::string, double>> stages;  // wall seconds, this call

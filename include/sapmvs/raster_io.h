@@ -50,4 +50,13 @@ GeoRaster ReadGeoRaster(const std::filesystem::path& path);
 // to OGR's default WKT; "" stays "". Throws sapmvs::Error naming the text.
 std::string CrsToWkt(const std::string& crs);
 
+// How a report names a CRS: its EPSG code (0 when it has none that PROJ can
+// find without the network) and its name ("WGS 84 / UTM zone 32N").
+struct CrsIdentity {
+  int epsg = 0;
+  std::string name;
+};
+// `crs` as CrsToWkt takes it, not empty. Throws sapmvs::Error naming the text.
+CrsIdentity IdentifyCrs(const std::string& crs);
+
 }  // namespace sapmvs
