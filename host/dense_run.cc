@@ -14,6 +14,7 @@
 
 #include "cl_runtime.h"
 #include "run_checkpoint.h"
+#include "run_progress.h"
 #include "run_report.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
@@ -192,6 +193,16 @@ RunReport RunDense(const RunOptions& options) {
 
   const bool show = options.matcher.progress && Progress::TerminalAllowsProgress();
   const int n = static_cast<int>(plan.groups.size());
+  // The groups this call will match, for the ETA: not checkpointed, and at
+  // most max_groups of them.
+  int to_match = 0;
+  long images_to_match = 0;
+  for (int g = 0; g < n; ++g) {
+    if (checkpoints.Done(g) || (options.max_groups > 0 && to_match >= options.max_groups)) continue;
+    ++to_match;
+    images_to_match += static_cast<long>(plan.groups[g].images.size());
+  }
+  RunProgress progress(to_match, images_to_match, show);
   int matched_now = 0;
   bool stopped = false;  // groups left for a later call (max_groups)
   for (int g = 0; g < n; ++g) {
@@ -211,14 +222,14 @@ RunReport RunDense(const RunOptions& options) {
       report.groups.push_back(run);
       continue;
     }
-    if (show) {
-      std::fprintf(stderr, "group %d/%d: %zu images\n", g + 1, n, plan.groups[g].images.size());
-    }
+    progress.StartGroup(g, n, static_cast<long>(plan.groups[g].images.size()));
     const auto t0 = std::chrono::steady_clock::now();
     MatchResult result =
-        MatchGroup(block, plan.groups[g].images, options.matcher, context, &geometry);
+        MatchGroup(block, plan.groups[g].images, options.matcher, context, &geometry,
+                   [&](const MatchProgressEvent& e) { progress.Update(e); });
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
+    progress.EndGroup(run.points);
     AddStats(result.stats, &report.stats);
     for (const auto& [name, t] : result.stats.stages) {
       LogDetail("group " + std::to_string(g + 1) + "/" + std::to_string(n) + ": " + name + " " +
@@ -229,6 +240,7 @@ RunReport RunDense(const RunOptions& options) {
     ++matched_now;
     report.groups.push_back(run);
   }
+  progress.Finish();
   end_stage("match");
   if (stopped) {
     report.total_seconds = Since(start);

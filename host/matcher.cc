@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "cl_runtime.h"
@@ -14,6 +15,7 @@
 #include "patch_engine.h"
 #include "patch_filter.h"
 #include "propagation.h"
+#include "run_progress.h"
 #include "sapmvs/error.h"
 #include "sapmvs/kernel_limits.h"
 #include "sapmvs/memory_use.h"
@@ -115,7 +117,7 @@ bool MatcherOptions::Check() const {
 
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, ClContext& context,
-                       const BlockGeometry* geometry) {
+                       const BlockGeometry* geometry, const MatchProgressFn& on_progress) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("matcher options: expected " + problem);
   std::vector<int> ids = image_ids;
@@ -124,7 +126,19 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   }
   MatchResult result;
   MatchStats& stats = result.stats;
-  const bool show = options.progress && Progress::TerminalAllowsProgress();
+  // Without a caller's display, a one-group status line of our own.
+  std::optional<RunProgress> own;
+  if (!on_progress && options.progress && Progress::TerminalAllowsProgress()) {
+    own.emplace(1, static_cast<long>(ids.size()), true);
+    own->StartGroup(0, 1, static_cast<long>(ids.size()));
+  }
+  auto report = [&](const std::string& stage, long done = 0, long total = 0,
+                    const std::string& detail = "") {
+    const MatchProgressEvent e{stage, done, total, detail};
+    if (on_progress) on_progress(e);
+    if (own) own->Update(e);
+  };
+  report("load");
   auto stage_start = std::chrono::steady_clock::now();
   double device_before = 0;
   const PatchEngine* engine_ptr = nullptr;
@@ -153,6 +167,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   stats.images = static_cast<int>(group.images.size());
   stats.gsd = group.gsd;
   end_stage("load");
+  report("features");
 
   const int largest = options.mode == MatchMode::kSapmvs
                           ? std::max(options.window_size, options.adaptive_sizes.front())
@@ -165,11 +180,15 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   }
   end_stage("features");
 
+  report("seeds", 0, 0, "epipolar candidates");
   const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  report("seeds", 0, 0, "building kernels");
   PatchEngine engine(context, group, options);
   engine_ptr = &engine;
   Propagator propagator(group, options, engine);
-  propagator.RunSeeds(seeds);
+  propagator.RunSeeds(seeds, [&](long rank, long ranks, long accepted) {
+    report("seeds", rank, ranks, std::to_string(accepted) + " accepted");
+  });
   stats.seeds_tried = propagator.seeds_tried();
   stats.seeds_accepted = propagator.seeds_accepted();
   end_stage("seeds");
@@ -190,6 +209,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     return ranges;
   };
   if (options.mode == MatchMode::kSapmvs && options.use_edges) {
+    report("edges");
     const auto ranges = seed_depth_ranges(0.25, 2.0);
     EdgeMatchStats es;
     propagator.SetEdges(MatchEdges(group, options, ranges, engine, &es));
@@ -221,13 +241,12 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   for (int pass = 0; pass < options.expand_iterations; ++pass) {
     if (pass > 0) propagator.Prune(keep);
     propagator.RunWaves([&](long wave, long size, long emitted) {
-      if (!show) return;
-      std::fprintf(stderr, "\r%s: pass %d, wave %ld, %ld candidates, %ld points   ",
-                   ToString(options.mode).c_str(), pass + 1, wave, size, emitted);
-      std::fflush(stderr);
+      report("propagation", pass + 1, options.expand_iterations,
+             "wave " + std::to_string(wave) + ", " + std::to_string(size) + " candidates, " +
+                 std::to_string(emitted) + " points");
     });
-    if (show) std::fprintf(stderr, "\n");
     end_stage("propagation");
+    report("filter", pass + 1, options.expand_iterations);
 
     if (pass == 0) {
       // The fence, from the scores of the points of the first expansion.
@@ -292,6 +311,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   stats.points = static_cast<long>(cloud.points.size());
   stats.kernels = engine.kernel_times();
   end_stage("output");
+  if (own) own->Finish();
   return result;
 }
 

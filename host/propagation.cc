@@ -190,7 +190,8 @@ std::vector<int> Propagator::AcceptBatch(std::vector<std::optional<AcceptedPatch
   return accepted;
 }
 
-void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds) {
+void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
+                          const std::function<void(long, long, long)>& on_rank) {
   std::vector<uint8_t> done(seeds.size(), 0);
   const int cs = options_.cell_size;
   for (int rank = 0; rank < options_.candidates_per_feature; ++rank) {
@@ -214,6 +215,7 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds) {
         ++seeds_accepted_;
       }
     }
+    if (on_rank) on_rank(rank + 1, options_.candidates_per_feature, seeds_accepted_);
   }
   for (size_t p = 0; p < patches_.size(); ++p) {
     const Camera& cam = group_.images[patches_[p].ref].camera;

@@ -43,7 +43,9 @@ class Propagator {
 
   // Tries each feature's candidates in order, one batch per rank, keeping
   // the first accepted; accepted seeds start the front.
-  void RunSeeds(const std::vector<SeedFeature>& seeds);
+  // `on_rank(rank, ranks, accepted)` after each rank of candidates is scored.
+  void RunSeeds(const std::vector<SeedFeature>& seeds,
+                const std::function<void(long, long, long)>& on_rank = {});
   // Edge barriers for the flood fill (sapmvs mode); one map per image.
   void SetEdges(std::vector<EdgeMap> edges) { edges_ = std::move(edges); }
   // Waves until the front is empty (or max_waves). `on_wave` (may be empty)

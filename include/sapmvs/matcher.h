@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sapmvs/block.h"
+#include "sapmvs/match_progress.h"
 #include "sapmvs/ply_io.h"
 
 namespace sapmvs {
@@ -176,10 +177,13 @@ struct MatchResult {
 };
 
 // Matches images `image_ids` of `block` (all when empty). `geometry`:
-// EstimateBlockGeometry(block) when the caller already has it, else nullptr. Throws Error for
-// bad options, unreadable images or fewer than 2 usable images.
+// EstimateBlockGeometry(block) when the caller already has it, else nullptr.
+// `on_progress` hears each stage and wave; without it, options.progress
+// draws a status line of its own on a terminal. Throws Error for bad
+// options, unreadable images or fewer than 2 usable images.
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, ClContext& context,
-                       const BlockGeometry* geometry = nullptr);
+                       const BlockGeometry* geometry = nullptr,
+                       const MatchProgressFn& on_progress = {});
 
 }  // namespace sapmvs
