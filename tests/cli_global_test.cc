@@ -87,8 +87,7 @@ TEST(CliGlobalFlags, BadThreadCountIsOneLineNamingIt) {
 
 class CliLogTest : public test::ScratchTest {
  protected:
-  static fs::path Block() { return test::Simulated("cli_global", "tiny", 1) / "block.yaml"; }
-  static void TearDownTestSuite() { test::RemoveSimulated("cli_global"); }
+  static fs::path Block() { return test::Simulated("tiny", 1) / "block.yaml"; }
   static std::string Slurp(const fs::path& p) {
     std::ifstream in(p);
     std::stringstream s;

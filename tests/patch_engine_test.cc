@@ -168,8 +168,12 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
       grown += r && r->size > sapmvs.window_size;
     }
     EXPECT_EQ(accepted, 8) << "max_angle " << max_angle;
-    if (max_angle > 4) EXPECT_EQ(grown, 0);
-    if (max_angle < 4) EXPECT_GE(grown, 6);
+    if (max_angle > 4) {
+      EXPECT_EQ(grown, 0);
+    }
+    if (max_angle < 4) {
+      EXPECT_GE(grown, 6);
+    }
   }
   const PlaneScene narrow = MakePlaneScene(5, 201, 161, 96, 40.0 * std::tan(0.5 * kPiRad / 180.0));
   const MatchGroupData narrow_group = GroupOf(narrow);
