@@ -17,8 +17,8 @@
 #include "run_report.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
+#include "sapmvs/cloud_las.h"
 #include "sapmvs/error.h"
-#include "sapmvs/las_io.h"
 #include "sapmvs/memory_use.h"
 #include "sapmvs/output_folder.h"
 #include "sapmvs/ply_io.h"
@@ -112,22 +112,6 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
     d.max_seconds = std::max(d.max_seconds, k.max_seconds);
   }
   sum->gsd = s.gsd;
-}
-
-std::vector<PointRecord> ToLasRecords(const PointCloud& cloud) {
-  std::vector<PointRecord> out(cloud.points.size());
-  for (size_t i = 0; i < cloud.points.size(); ++i) {
-    const CloudPoint& p = cloud.points[i];
-    PointRecord& r = out[i];
-    r.x = p.position.x();
-    r.y = p.position.y();
-    r.z = p.position.z();
-    r.r = ColorTo16(p.color[0]);
-    r.g = ColorTo16(p.color[1]);
-    r.b = ColorTo16(p.color[2]);
-    r.classification = 1;  // unclassified
-  }
-  return out;
 }
 
 }  // namespace
@@ -265,8 +249,9 @@ RunReport RunDense(const RunOptions& options) {
 
   WritePly(options.out / "cloud.ply", merged);
   LasWriteOptions lo;
+  lo.version = options.las_version;
   lo.crs = block.crs;
-  WriteLas(options.out / "cloud.las", ToLasRecords(merged), lo);
+  WriteCloudLas(options.out / "cloud.las", merged, lo);
   WriteGeoTiff(options.out / "dsm.tif", dsm);
   WriteReliefPng(options.out / "dsm.png", dsm);
   end_stage("write");
