@@ -42,7 +42,9 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   auto block_flags = std::make_shared<BlockFlags>();
   MatcherOptions& m = o->matcher;
   CLI::App* cmd = app.add_subcommand(
-      "run", "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json");
+      "run",
+      "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png, "
+      "report.json");
   cmd->add_option("block", o->block,
                   "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
       ->required();

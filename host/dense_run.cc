@@ -18,6 +18,7 @@
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/cloud_las.h"
+#include "sapmvs/dsm_picture.h"
 #include "sapmvs/error.h"
 #include "sapmvs/memory_use.h"
 #include "sapmvs/output_folder.h"
@@ -253,7 +254,7 @@ RunReport RunDense(const RunOptions& options) {
   lo.crs = block.crs;
   WriteCloudLas(options.out / "cloud.las", merged, lo);
   WriteGeoTiff(options.out / "dsm.tif", dsm);
-  WriteReliefPng(options.out / "dsm.png", dsm);
+  WriteDsmPictures(dsm, options.out / "dsm_color.tif", options.out / "dsm.png");
   end_stage("write");
   report.finished = true;
   report.total_seconds = Since(start);
@@ -326,7 +327,8 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
   out << std::setprecision(2);
   out << "total         " << report.total_seconds << " s, peak memory "
       << report.peak_rss_bytes / (1 << 20) << " MiB\n";
-  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm.png", "report.json"}) {
+  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm_color.tif", "dsm.png", "dsm.pgw",
+                        "report.json"}) {
     out << "wrote         " << (report.out / f).string() << "\n";
   }
   out.unsetf(std::ios::floatfield);

@@ -1,13 +1,18 @@
 // What `sapmvs run` writes, read back by the tools users open it with:
 // cloud.las by @loaders.gl/las and copc.js (node, from npm) and by our own
-// reader, in both LAS versions. One run per version for the whole suite.
+// reader, in both LAS versions; the DSM's pictures by GDAL and OpenCV. One run
+// per LAS version for the whole suite.
+#include <gdal_priv.h>
 #include <gtest/gtest.h>
+#include <ogr_spatialref.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
 
@@ -178,6 +183,43 @@ TEST_F(CliRunOutputsTest, OurReaderReadsBothVersionsWithTheirExtraBytes) {
       }
     }
   }
+}
+
+TEST_F(CliRunOutputsTest, DsmPicturesShareTheDsmsGeoreference) {
+  const fs::path out = Out("1.2");
+  GDALAllRegister();
+  std::unique_ptr<GDALDataset> dsm(GDALDataset::Open((out / "dsm.tif").c_str(), GDAL_OF_RASTER));
+  std::unique_ptr<GDALDataset> color(
+      GDALDataset::Open((out / "dsm_color.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(dsm && color);
+  EXPECT_EQ(color->GetRasterCount(), 4);
+  EXPECT_EQ(color->GetRasterXSize(), dsm->GetRasterXSize());
+  EXPECT_EQ(color->GetRasterYSize(), dsm->GetRasterYSize());
+  double a[6], b[6];
+  ASSERT_EQ(dsm->GetGeoTransform(a), CE_None);
+  ASSERT_EQ(color->GetGeoTransform(b), CE_None);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(a[i], b[i]) << i;
+  ASSERT_TRUE(dsm->GetSpatialRef() && color->GetSpatialRef());
+  EXPECT_TRUE(color->GetSpatialRef()->IsSame(dsm->GetSpatialRef()));
+
+  // The world file places the PNG's pixels on the same ground, k per cell.
+  std::ifstream in(out / "dsm.pgw");
+  std::vector<double> w;
+  for (double x; in >> x;) w.push_back(x);
+  ASSERT_EQ(w.size(), 6u);
+  const double k = a[1] / w[0];
+  EXPECT_NEAR(k, std::round(k), 1e-9);
+  EXPECT_GE(k, 1);
+  EXPECT_DOUBLE_EQ(w[3], -w[0]);
+  EXPECT_DOUBLE_EQ(w[4], a[0] + w[0] / 2);
+  EXPECT_DOUBLE_EQ(w[5], a[3] - w[0] / 2);
+  const cv::Mat png = cv::imread((out / "dsm.png").string());
+  ASSERT_FALSE(png.empty());
+  const int map_w = static_cast<int>(std::lround(k)) * dsm->GetRasterXSize();
+  const int map_h = static_cast<int>(std::lround(k)) * dsm->GetRasterYSize();
+  EXPECT_GE(std::min(map_w, map_h), 600) << "the small demo DSM is enlarged";
+  EXPECT_GT(png.cols, map_w + 100) << "the legend lies right of the map";
+  EXPECT_GE(png.rows, map_h);
 }
 
 }  // namespace

@@ -6,7 +6,8 @@
 //   DIR/cloud.ply    binary, world coordinates in double, CRS in the header
 //   DIR/cloud.las    LAS 1.2 or 1.4 with RGB, score, views and normals
 //                    (cloud_las.h) and the block's CRS
-//   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h), DIR/dsm.png its colour relief
+//   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h); its pictures (dsm_picture.h):
+//                    DIR/dsm_color.tif (georeferenced), DIR/dsm.png + dsm.pgw
 //   DIR/report.json  points, groups, per-stage wall and device times, kernel
 //                    times, the paper's statistics (Tables 4, 6, 8)
 // A killed run resumes from its last finished group; the merge always reads
