@@ -38,10 +38,13 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   auto strategy = std::make_shared<std::string>("strip");
   auto budget = std::make_shared<std::string>("8G");
   auto profile = std::make_shared<std::string>();
+  auto las_version = std::make_shared<std::string>(ToString(o->las_version));
   auto block_flags = std::make_shared<BlockFlags>();
   MatcherOptions& m = o->matcher;
   CLI::App* cmd = app.add_subcommand(
-      "run", "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json");
+      "run",
+      "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png, "
+      "report.json");
   cmd->option_defaults()->group("Input");
   cmd->add_option("block", o->block,
                   "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
@@ -139,6 +142,9 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       ->capture_default_str();
   cmd->add_option("--dsm-fill", o->dsm.fill_passes, "DSM gap-filling passes")
       ->capture_default_str();
+  cmd->add_option("--las-version", *las_version,
+                  "cloud.las: 1.2 (format 2, every reader opens it) or 1.4 (format 7)")
+      ->capture_default_str();
   cmd->option_defaults()->group("Output and resume");
   CLI::Option* profile_option =
       cmd->add_option("--profile", *profile,
@@ -153,28 +159,30 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       "  sapmvs run block.yaml --out out/run --max-groups 1   one group now; the same\n"
       "                                                   command later resumes\n"
       "  sapmvs run block.yaml --out out/run --restart    discard the checkpoints\n"
-      "Outputs in DIR: cloud.ply, cloud.las, dsm.tif, dsm.png, report.json, groups/.");
-  cmd->callback(
-      [o, block_flags, mode, no_edges, strategy, budget, profile, profile_option, &global] {
-        o->read = ReadOptionsOf(*block_flags);
-        o->profile = profile_option->count() > 0;
-        o->grouping.strategy = ParseGroupingStrategy(*strategy);
-        o->grouping.memory_budget = ParseByteSize(*budget);
-        o->matcher.mode = ParseMatchMode(*mode);
-        o->matcher.use_edges = !*no_edges;
-        o->matcher.progress = !global.quiet;
-        o->command_line = global.command_line;
-        if (o->profile && !profile->empty()) CheckProfilePath(*profile, o->out);
-        const RunReport report = RunDense(*o);
-        PrintRunSummary(report, std::cout);
-        if (o->profile) {
-          PrintProfile(report, std::cout);
-          const std::filesystem::path csv =
-              profile->empty() ? o->out / "profile.csv" : std::filesystem::path(*profile);
-          WriteProfile(report, csv);
-          std::cout << "profile       " << csv.string() << " (and .json)\n";
-        }
-      });
+      "Outputs in DIR: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png (+ .pgw),\n"
+      "report.json, groups/.");
+  cmd->callback([o, block_flags, mode, no_edges, strategy, budget, profile, profile_option,
+                 las_version, &global] {
+    o->read = ReadOptionsOf(*block_flags);
+    o->profile = profile_option->count() > 0;
+    o->grouping.strategy = ParseGroupingStrategy(*strategy);
+    o->grouping.memory_budget = ParseByteSize(*budget);
+    o->matcher.mode = ParseMatchMode(*mode);
+    o->las_version = ParseLasVersion(*las_version);
+    o->matcher.use_edges = !*no_edges;
+    o->matcher.progress = !global.quiet;
+    o->command_line = global.command_line;
+    if (o->profile && !profile->empty()) CheckProfilePath(*profile, o->out);
+    const RunReport report = RunDense(*o);
+    PrintRunSummary(report, std::cout);
+    if (o->profile) {
+      PrintProfile(report, std::cout);
+      const std::filesystem::path csv =
+          profile->empty() ? o->out / "profile.csv" : std::filesystem::path(*profile);
+      WriteProfile(report, csv);
+      std::cout << "profile       " << csv.string() << " (and .json)\n";
+    }
+  });
 }
 
 }  // namespace sapmvs::cli

@@ -7,8 +7,6 @@
 #include <fstream>
 #include <limits>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <unordered_map>
 
@@ -167,62 +165,6 @@ GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options, doubl
   }
   if (cell_size_used) *cell_size_used = cell;
   return r;
-}
-
-void WriteReliefPng(const std::filesystem::path& path, const GeoRaster& dsm) {
-  std::vector<float> valid;
-  for (const float v : dsm.values) {
-    if (std::isfinite(v)) valid.push_back(v);
-  }
-  if (valid.empty()) throw Error(path.string() + ": the DSM has no valid cell to draw");
-  std::sort(valid.begin(), valid.end());
-  const double lo = valid[valid.size() / 100];
-  const double hi = std::max(lo + 1e-6, static_cast<double>(valid[valid.size() * 99 / 100]));
-  cv::Mat grey(dsm.height, dsm.width, CV_8UC1);
-  cv::Mat shade(dsm.height, dsm.width, CV_32FC1);
-  // Hillshade with the sun at azimuth 315, altitude 45 degrees.
-  const double az = 315.0 * M_PI / 180.0, alt = 45.0 * M_PI / 180.0;
-  const Eigen::Vector3d sun(std::sin(az) * std::cos(alt), std::cos(az) * std::cos(alt),
-                            std::sin(alt));
-  auto z = [&](int c, int r) {
-    c = std::clamp(c, 0, dsm.width - 1);
-    r = std::clamp(r, 0, dsm.height - 1);
-    return static_cast<double>(dsm.at(c, r));
-  };
-  for (int r = 0; r < dsm.height; ++r) {
-    for (int c = 0; c < dsm.width; ++c) {
-      const float v = dsm.at(c, r);
-      grey.at<uint8_t>(r, c) =
-          std::isfinite(v)
-              ? static_cast<uint8_t>(std::clamp((v - lo) / (hi - lo), 0.0, 1.0) * 255.0 + 0.5)
-              : 0;
-      double dzdx = 0.5 * (z(c + 1, r) - z(c - 1, r)) / dsm.cell_size;
-      double dzdy = 0.5 * (z(c, r - 1) - z(c, r + 1)) / dsm.cell_size;  // rows run south
-      if (!std::isfinite(dzdx)) dzdx = 0;
-      if (!std::isfinite(dzdy)) dzdy = 0;
-      const Eigen::Vector3d n = Eigen::Vector3d(-dzdx, -dzdy, 1).normalized();
-      shade.at<float>(r, c) = static_cast<float>(0.35 + 0.65 * std::max(0.0, n.dot(sun)));
-    }
-  }
-  cv::Mat colour;
-  cv::applyColorMap(grey, colour, cv::COLORMAP_TURBO);
-  for (int r = 0; r < dsm.height; ++r) {
-    for (int c = 0; c < dsm.width; ++c) {
-      cv::Vec3b& px = colour.at<cv::Vec3b>(r, c);
-      if (!std::isfinite(dsm.at(c, r))) {
-        px = cv::Vec3b(220, 220, 220);
-        continue;
-      }
-      const float s = shade.at<float>(r, c);
-      for (int k = 0; k < 3; ++k) px[k] = cv::saturate_cast<uint8_t>(px[k] * s);
-    }
-  }
-  std::vector<uint8_t> bytes;
-  if (!cv::imencode(".png", colour, bytes)) throw Error(path.string() + ": PNG encoding failed");
-  WriteStreamAtomically(path, [&](std::ostream& f) {
-    f.write(reinterpret_cast<const char*>(bytes.data()),
-            static_cast<std::streamsize>(bytes.size()));
-  });
 }
 
 }  // namespace sapmvs

@@ -18,6 +18,8 @@
 #include "run_report.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
+#include "sapmvs/cloud_las.h"
+#include "sapmvs/dsm_picture.h"
 #include "sapmvs/error.h"
 #include "sapmvs/las_io.h"
 #include "sapmvs/log.h"
@@ -120,22 +122,6 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
     d.max_seconds = std::max(d.max_seconds, k.max_seconds);
   }
   sum->gsd = s.gsd;
-}
-
-std::vector<PointRecord> ToLasRecords(const PointCloud& cloud) {
-  std::vector<PointRecord> out(cloud.points.size());
-  for (size_t i = 0; i < cloud.points.size(); ++i) {
-    const CloudPoint& p = cloud.points[i];
-    PointRecord& r = out[i];
-    r.x = p.position.x();
-    r.y = p.position.y();
-    r.z = p.position.z();
-    r.r = ColorTo16(p.color[0]);
-    r.g = ColorTo16(p.color[1]);
-    r.b = ColorTo16(p.color[2]);
-    r.classification = 1;  // unclassified
-  }
-  return out;
 }
 
 }  // namespace
@@ -283,10 +269,11 @@ RunReport RunDense(const RunOptions& options) {
 
   WritePly(options.out / "cloud.ply", merged);
   LasWriteOptions lo;
+  lo.version = options.las_version;
   lo.crs = block.crs;
-  WriteLas(options.out / "cloud.las", ToLasRecords(merged), lo);
+  WriteCloudLas(options.out / "cloud.las", merged, lo);
   WriteGeoTiff(options.out / "dsm.tif", dsm);
-  WriteReliefPng(options.out / "dsm.png", dsm);
+  WriteDsmPictures(dsm, options.out / "dsm_color.tif", options.out / "dsm.png");
   end_stage("write");
   report.finished = true;
   report.total_seconds = Since(start);
@@ -360,7 +347,8 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
   out << std::setprecision(2);
   out << "total         " << report.total_seconds << " s, peak memory "
       << report.peak_rss_bytes / (1 << 20) << " MiB\n";
-  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm.png", "report.json"}) {
+  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm_color.tif", "dsm.png", "dsm.pgw",
+                        "report.json"}) {
     out << "wrote         " << (report.out / f).string() << "\n";
   }
   out.unsetf(std::ios::floatfield);

@@ -163,17 +163,25 @@ ErrorRow ComputeErrorRow(const std::vector<double>& dz, double tolerance, double
   return row;
 }
 
-std::vector<Eigen::Vector3d> ReadCloudPositions(const std::filesystem::path& path) {
+std::vector<Eigen::Vector3d> ReadCloudPositions(const std::filesystem::path& path,
+                                                std::string* crs) {
   RequirePointExtension(path);
   const std::string ext = LowerExtension(path);
   std::vector<Eigen::Vector3d> points;
   if (ext == ".ply") {
     const PointCloud cloud = ReadPly(path);
+    if (crs) *crs = cloud.crs;
     points.reserve(cloud.points.size());
     for (const CloudPoint& p : cloud.points) points.push_back(p.position);
   } else {
-    const std::vector<PointRecord> records =
-        ext == ".las" ? ReadLas(path).points : ReadXyz(path).points;
+    std::vector<PointRecord> records;
+    if (ext == ".las") {
+      LasCloud las = ReadLas(path);
+      if (crs) *crs = las.crs_wkt;
+      records = std::move(las.points);
+    } else {
+      records = ReadXyz(path).points;
+    }
     points.reserve(records.size());
     for (const PointRecord& p : records) points.emplace_back(p.x, p.y, p.z);
   }
@@ -278,11 +286,19 @@ EvaluationReport Evaluate(const EvaluateOptions& options) {
     throw Error(options.plots.string() + ": --plots expects a folder, this is a file");
   }
 
-  std::vector<Eigen::Vector3d> cloud = ReadCloudPositions(options.cloud);
+  std::string cloud_crs, reference_crs;
+  std::vector<Eigen::Vector3d> cloud = ReadCloudPositions(options.cloud, &cloud_crs);
+  // The plots' axes are labelled with the reference's unit, else the cloud's.
+  auto with_unit = [&](EvaluationReport r) {
+    r.unit = CrsLinearUnit(reference_crs.empty() ? cloud_crs : reference_crs);
+    return r;
+  };
   if (kind == ReferenceKind::kLidar) {
-    return EvaluateAgainstLidar(std::move(cloud), ReadCloudPositions(options.reference), options);
+    std::vector<Eigen::Vector3d> lidar = ReadCloudPositions(options.reference, &reference_crs);
+    return with_unit(EvaluateAgainstLidar(std::move(cloud), lidar, options));
   }
   const GeoRaster dsm = ReadGeoRaster(options.reference);
+  reference_crs = dsm.crs;
   std::optional<DsmFootprint> footprint;
   if (!options.footprint.empty()) {
     const std::vector<double>& b = options.footprint;
@@ -292,7 +308,8 @@ EvaluationReport Evaluate(const EvaluateOptions& options) {
     read.check_image_sizes = false;  // only the orientation is used
     footprint = FootprintFromBlock(dsm, ReadBlock(options.block, read));
   }
-  return EvaluateAgainstDsm(std::move(cloud), dsm, footprint ? &*footprint : nullptr, options);
+  return with_unit(
+      EvaluateAgainstDsm(std::move(cloud), dsm, footprint ? &*footprint : nullptr, options));
 }
 
 }  // namespace sapmvs

@@ -1,6 +1,6 @@
 // The evaluation's PNG plots: a histogram of dz, a map of dz over XY with a
-// colour bar, and a map of where the pseudo-errors are. Drawn with OpenCV so
-// that no plotting stack is needed.
+// colour bar, and a map of where the pseudo-errors are, every axis with its
+// unit. Drawn with OpenCV so that no plotting stack is needed.
 
 #include <algorithm>
 #include <cmath>
@@ -20,8 +20,12 @@ namespace {
 // Layout, in pixels: the plot area's longest side and the margins around it
 // (room for the title, axis labels and the colour bar).
 constexpr int kPlotSide = 800;
-constexpr int kMarginLeft = 80, kMarginRight = 130, kMarginTop = 60, kMarginBottom = 50;
+constexpr int kMarginLeft = 90, kMarginRight = 130, kMarginTop = 60, kMarginBottom = 50;
 constexpr int kHistogramBins = 80;
+// The maps merge pixels into blocks of up to this many pixels a side (a
+// power of two) until a typical block with points holds this many.
+constexpr int kMaxBlock = 64;
+constexpr double kPointsPerBlock = 2;
 // The colour and histogram range is this quantile of |dz|, so that
 // pseudo-errors of tens of metres (often several percent of the points on
 // building edges) do not flatten everything else.
@@ -49,6 +53,50 @@ double NiceCeil(double v) {
     if (m * p >= v * (1 - 1e-12)) return m * p;
   }
   return 10 * p;
+}
+
+// " (m)" for axis labels; CRS units when the inputs had no CRS.
+std::string Unit(const EvaluationReport& r, bool vertical) {
+  if (r.unit.empty()) return " (CRS units)";
+  return " (" + (vertical && r.unit == "deg" ? std::string("m") : r.unit) + ")";
+}
+
+// Block sums of `m` (CV_64F), f x f pixels each: INTER_AREA over whole blocks
+// is their exact mean, times f^2.
+cv::Mat BlockSums(const cv::Mat& m, int f) {
+  cv::Mat padded, out;
+  cv::copyMakeBorder(m, padded, 0, (f - m.rows % f) % f, 0, (f - m.cols % f) % f,
+                     cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::resize(padded, out, {padded.cols / f, padded.rows / f}, 0, 0, cv::INTER_AREA);
+  return out * (f * f);
+}
+
+// Per-pixel sums and counts over the plot merged into blocks large enough
+// that a typical block with points holds kPointsPerBlock of them, then shown
+// block by block. Pixels finer than the point spacing would otherwise show
+// the points' lattice beating against the pixels' as a moire of dots and
+// gaps; area averaging over whole blocks keeps every point and no pattern.
+struct Blocks {
+  int f = 1;
+  cv::Mat sum, count;  // per block
+  // The block of plot pixel (x, y).
+  double Sum(int x, int y) const { return sum.at<double>(y / f, x / f); }
+  double Count(int x, int y) const { return count.at<double>(y / f, x / f); }
+};
+Blocks MergeIntoBlocks(const cv::Mat& sum, const cv::Mat& count) {
+  Blocks b;
+  for (b.f = 1;; b.f *= 2) {
+    b.count = BlockSums(count, b.f);
+    std::vector<double> occupied;
+    for (auto it = b.count.begin<double>(); it != b.count.end<double>(); ++it) {
+      if (*it > 0.5) occupied.push_back(*it);
+    }
+    if (occupied.empty() || b.f >= kMaxBlock) break;
+    std::nth_element(occupied.begin(), occupied.begin() + occupied.size() / 2, occupied.end());
+    if (occupied[occupied.size() / 2] >= kPointsPerBlock) break;
+  }
+  b.sum = BlockSums(sum, b.f);
+  return b;
 }
 
 // The symmetric range [-R, R] of the colour scale and histogram.
@@ -106,15 +154,25 @@ struct MapFrame {
     return {kMarginLeft + static_cast<int>(std::lround((p.x() - min.x()) * scale)),
             kMarginTop + static_cast<int>(std::lround((max.y() - p.y()) * scale))};
   }
-  cv::Mat Canvas() const {
-    cv::Mat img(kMarginTop + height + kMarginBottom, kMarginLeft + width + kMarginRight, CV_8UC3,
-                kWhite);
+  // The plot area with X (east) and Y (north) axes, ticks and their unit.
+  cv::Mat Canvas(const std::string& unit) const {
+    cv::Mat img(kMarginTop + height + kMarginBottom + 20, kMarginLeft + width + kMarginRight,
+                CV_8UC3, kWhite);
     cv::rectangle(img, {kMarginLeft - 1, kMarginTop - 1},
                   {kMarginLeft + width, kMarginTop + height}, kBlack);
-    const int below = kMarginTop + height + 20;
-    Text(&img, "X " + Fmt("%.2f", min.x()) + " .. " + Fmt("%.2f", max.x()), kMarginLeft, below);
-    Text(&img, "Y " + Fmt("%.2f", min.y()) + " .. " + Fmt("%.2f", max.y()) + " (north up)",
-         kMarginLeft, below + 20);
+    const double step = NiceCeil(std::max(max.x() - min.x(), max.y() - min.y()) / 5);
+    for (double x = std::ceil(min.x() / step) * step; x <= max.x(); x += step) {
+      const int px = kMarginLeft + static_cast<int>(std::lround((x - min.x()) * scale));
+      cv::line(img, {px, kMarginTop + height}, {px, kMarginTop + height + 5}, kBlack);
+      Text(&img, Fmt("%.10g", x), px - 25, kMarginTop + height + 20, 0.4);
+    }
+    for (double y = std::ceil(min.y() / step) * step; y <= max.y(); y += step) {
+      const int py = kMarginTop + static_cast<int>(std::lround((max.y() - y) * scale));
+      cv::line(img, {kMarginLeft - 6, py}, {kMarginLeft - 1, py}, kBlack);
+      Text(&img, Fmt("%.10g", y), 4, py + 4, 0.4);
+    }
+    Text(&img, "X, east" + unit + "; north up", kMarginLeft, kMarginTop + height + 42);
+    Text(&img, "Y" + unit, 4, kMarginTop - 8);
     return img;
   }
   Eigen::Vector2d min, max;
@@ -133,7 +191,7 @@ cv::Mat Histogram(const EvaluationReport& r, double range) {
   }
   const long peak = std::max<long>(1, *std::max_element(bins.begin(), bins.end()));
   const int w = kPlotSide, h = kPlotSide / 2;
-  cv::Mat img(kMarginTop + h + kMarginBottom, kMarginLeft + w + 40, CV_8UC3, kWhite);
+  cv::Mat img(kMarginTop + h + kMarginBottom + 10, kMarginLeft + w + 40, CV_8UC3, kWhite);
   const int bar = w / kHistogramBins;
   for (int b = 0; b < kHistogramBins; ++b) {
     const int top = kMarginTop + h - static_cast<int>(std::lround(double(bins[b]) / peak * h));
@@ -158,8 +216,10 @@ cv::Mat Histogram(const EvaluationReport& r, double range) {
   }
   Text(&img, std::to_string(peak), 5, kMarginTop + 10);
   Text(&img, "0", 5, kMarginTop + h);
-  Text(&img, "dz = Z - Z_ref of " + std::to_string(n) + " checkpoints (no threshold)", kMarginLeft,
-       22, 0.55);
+  Text(&img, "points", 5, kMarginTop + h / 2);
+  Text(&img, "per bin", 5, kMarginTop + h / 2 + 16);
+  Text(&img, "dz = Z - Z_ref" + Unit(r, true), kMarginLeft + w / 2 - 70, kMarginTop + h + 42);
+  Text(&img, "dz of " + std::to_string(n) + " checkpoints (no threshold)", kMarginLeft, 22, 0.55);
   Text(&img,
        "values beyond +-" + Fmt("%g", range) + " are counted in the end bins; green: +-tolerance " +
            Fmt("%g", r.tolerance),
@@ -169,25 +229,27 @@ cv::Mat Histogram(const EvaluationReport& r, double range) {
 
 cv::Mat ErrorMap(const EvaluationReport& r, double range) {
   const MapFrame frame(r.points);
-  cv::Mat img = frame.Canvas();
-  // Several points per pixel: their mean dz.
-  cv::Mat sum(img.size(), CV_64F, cv::Scalar(0)), count(img.size(), CV_32S, cv::Scalar(0));
-  cv::Mat no_reference(img.size(), CV_8U, cv::Scalar(0));
+  cv::Mat img = frame.Canvas(Unit(r, false));
+  cv::Mat sum(frame.height, frame.width, CV_64F, cv::Scalar(0));
+  cv::Mat count = sum.clone(), no_reference = sum.clone();
   for (size_t i = 0; i < r.points.size(); ++i) {
-    const cv::Point p = frame.Pixel(r.points[i]);
+    const cv::Point p = frame.Pixel(r.points[i]) - cv::Point(kMarginLeft, kMarginTop);
     if (std::isfinite(r.dz[i])) {
       sum.at<double>(p) += r.dz[i];
-      ++count.at<int>(p);
+      count.at<double>(p) += 1;
     } else {
-      no_reference.at<uchar>(p) = 1;
+      no_reference.at<double>(p) += 1;
     }
   }
-  for (int y = 0; y < img.rows; ++y) {
-    for (int x = 0; x < img.cols; ++x) {
-      if (const int c = count.at<int>(y, x); c > 0) {
-        img.at<cv::Vec3b>(y, x) = Diverging(sum.at<double>(y, x) / c / range);
-      } else if (no_reference.at<uchar>(y, x)) {
-        img.at<cv::Vec3b>(y, x) = cv::Vec3b(120, 120, 120);
+  const Blocks dz = MergeIntoBlocks(sum, count);
+  const cv::Mat missing = BlockSums(no_reference, dz.f);
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      cv::Vec3b& px = img.at<cv::Vec3b>(kMarginTop + y, kMarginLeft + x);
+      if (const double c = dz.Count(x, y); c > 0.5) {
+        px = Diverging(dz.Sum(x, y) / c / range);
+      } else if (missing.at<double>(y / dz.f, x / dz.f) > 0.5) {
+        px = cv::Vec3b(120, 120, 120);
       }
     }
   }
@@ -207,7 +269,11 @@ cv::Mat ErrorMap(const EvaluationReport& r, double range) {
     cv::line(img, {x0 + 21, y}, {x0 + 26, y}, kBlack);
     Text(&img, Fmt("%+g", range * k / 2), x0 + 30, y + 5);
   }
-  Text(&img, "dz over XY: mean per pixel, clipped to +-" + Fmt("%g", range), kMarginLeft, 22, 0.55);
+  Text(&img, "dz" + Unit(r, true), x0 - 10, kMarginTop - 10);
+  Text(&img,
+       "mean dz per " + Fmt("%.3g", dz.f / frame.scale) + " " +
+           (r.unit.empty() ? "CRS units" : r.unit) + " cell, clipped to +-" + Fmt("%g", range),
+       kMarginLeft, 22, 0.55);
   Text(&img, "dark grey: no reference height", kMarginLeft, 44);
   return img;
 }
@@ -221,16 +287,31 @@ cv::Mat PseudoErrorMap(const EvaluationReport& r) {
     what = "|dz| > " + Fmt("%g", t) + ", dropped as pseudo-errors by the largest threshold";
   }
   const MapFrame frame(r.points);
-  cv::Mat img = frame.Canvas();
-  long marked = 0;
+  cv::Mat img = frame.Canvas(Unit(r, false));
+  // Kept and unreferenced points as areas, in blocks as in the dz map.
+  cv::Mat kept(frame.height, frame.width, CV_64F, cv::Scalar(0));
+  cv::Mat no_reference = kept.clone();
   for (size_t i = 0; i < r.points.size(); ++i) {
-    const cv::Point p = frame.Pixel(r.points[i]);
-    if (std::isfinite(r.dz[i])) {
-      if (std::abs(r.dz[i]) <= t) img.at<cv::Vec3b>(p) = cv::Vec3b(190, 190, 190);
-    } else {
-      img.at<cv::Vec3b>(p) = cv::Vec3b(230, 200, 150);
+    const cv::Point p = frame.Pixel(r.points[i]) - cv::Point(kMarginLeft, kMarginTop);
+    if (!std::isfinite(r.dz[i])) {
+      no_reference.at<double>(p) += 1;
+    } else if (std::abs(r.dz[i]) <= t) {
+      kept.at<double>(p) += 1;
     }
   }
+  const Blocks blocks = MergeIntoBlocks(kept, kept);
+  const cv::Mat missing = BlockSums(no_reference, blocks.f);
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      cv::Vec3b& px = img.at<cv::Vec3b>(kMarginTop + y, kMarginLeft + x);
+      if (blocks.Count(x, y) > 0.5) {
+        px = cv::Vec3b(190, 190, 190);
+      } else if (missing.at<double>(y / blocks.f, x / blocks.f) > 0.5) {
+        px = cv::Vec3b(230, 200, 150);
+      }
+    }
+  }
+  long marked = 0;
   // Marked points on top, as dots that stay visible when they are few.
   for (size_t i = 0; i < r.points.size(); ++i) {
     if (std::abs(r.dz[i]) > t) {

@@ -12,10 +12,10 @@
 #include <sstream>
 
 #include "input_file.h"
+#include "las_extra_bytes.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 #include "sapmvs/raster_io.h"
-#include "text_lines.h"
 
 namespace sapmvs {
 namespace {
@@ -23,13 +23,11 @@ namespace {
 // LAS is little-endian; fields are copied as-is.
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "LAS I/O needs byte swapping here");
 
-constexpr size_t kHeaderSize14 = 375;
+constexpr size_t kHeaderSize12 = 227, kHeaderSize14 = 375;
 constexpr size_t kVlrHeaderSize = 54;
 constexpr size_t kEvlrHeaderSize = 60;
-constexpr int kWriteFormat = 7;
-constexpr size_t kWriteRecordLength = 36;
 constexpr char kProjectionUserId[] = "LASF_Projection";
-constexpr uint16_t kWktRecordId = 2112;
+constexpr uint16_t kWktRecordId = 2112, kGeoKeyRecordId = 34735;
 constexpr uint16_t kWktEncodingBit = 1u << 4;
 constexpr int kMaxFormat = 10;
 // Bytes each point format needs, and where its RGB starts (-1: none).
@@ -124,28 +122,46 @@ int32_t Quantize(double v, double scale, double offset) {
   return static_cast<int32_t>(std::llround((v - offset) / scale));
 }
 
-void CheckPoints(const std::filesystem::path& path, const std::vector<PointRecord>& points) {
+// The point format each version is written in.
+int WriteFormat(LasVersion v) { return v == LasVersion::k12 ? 2 : 7; }
+
+void CheckPoints(const std::filesystem::path& path, const std::vector<PointRecord>& points,
+                 LasVersion version) {
+  const bool v12 = version == LasVersion::k12;
+  const int max_return = v12 ? 7 : 15;
   for (size_t i = 0; i < points.size(); ++i) {
     const PointRecord& p = points[i];
+    const std::string at = path.string() + ": point " + std::to_string(i);
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw Error(path.string() + ": point " + std::to_string(i) + " is (" + Num(p.x) + ", " +
-                  Num(p.y) + ", " + Num(p.z) + "); expected finite coordinates");
+      throw Error(at + " is (" + Num(p.x) + ", " + Num(p.y) + ", " + Num(p.z) +
+                  "); expected finite coordinates");
     }
-    if (p.return_number > 15 || p.number_of_returns > 15) {
-      throw Error(path.string() + ": point " + std::to_string(i) + " has return " +
-                  std::to_string(p.return_number) + " of " + std::to_string(p.number_of_returns) +
-                  "; expected at most 15 in LAS 1.4");
+    if (p.return_number > max_return || p.number_of_returns > max_return) {
+      throw Error(at + " has return " + std::to_string(p.return_number) + " of " +
+                  std::to_string(p.number_of_returns) + "; expected at most " +
+                  std::to_string(max_return) + " in LAS " + ToString(version));
     }
+    if (v12 && p.classification > 31) {
+      throw Error(at + " has class " + std::to_string(p.classification) +
+                  "; expected at most 31 in LAS 1.2 (LAS 1.4 holds up to 255)");
+    }
+  }
+  if (v12 && points.size() > std::numeric_limits<uint32_t>::max()) {
+    throw Error(path.string() + ": " + std::to_string(points.size()) +
+                " points; LAS 1.2 holds at most 4294967295 (use LAS 1.4)");
   }
 }
 
 std::vector<uint8_t> MakeHeader(const std::vector<PointRecord>& points, const Quantization& q,
-                                size_t vlr_bytes, const LasWriteOptions& options) {
-  std::vector<uint8_t> h(kHeaderSize14, 0);
+                                size_t vlr_bytes, uint32_t vlr_count, size_t record_length,
+                                const LasWriteOptions& options) {
+  const bool v12 = options.version == LasVersion::k12;
+  const size_t size = v12 ? kHeaderSize12 : kHeaderSize14;
+  std::vector<uint8_t> h(size, 0);
   std::memcpy(h.data(), "LASF", 4);
-  Put<uint16_t>(&h[6], kWktEncodingBit);
+  if (!v12) Put<uint16_t>(&h[6], kWktEncodingBit);
   h[24] = 1;
-  h[25] = 4;
+  h[25] = v12 ? 2 : 4;
   std::snprintf(reinterpret_cast<char*>(&h[26]), 32, "%s", "OTHER");
   std::snprintf(reinterpret_cast<char*>(&h[58]), 32, "sapmvs %s", SAPMVS_VERSION);
   const std::time_t now = std::time(nullptr);
@@ -155,54 +171,96 @@ std::vector<uint8_t> MakeHeader(const std::vector<PointRecord>& points, const Qu
                                                                        : utc.tm_yday + 1));
   Put<uint16_t>(&h[92], static_cast<uint16_t>(options.creation_year > 0 ? options.creation_year
                                                                         : utc.tm_year + 1900));
-  Put<uint16_t>(&h[94], kHeaderSize14);
-  Put<uint32_t>(&h[96], static_cast<uint32_t>(kHeaderSize14 + vlr_bytes));
-  Put<uint32_t>(&h[100], vlr_bytes > 0 ? 1 : 0);
-  h[104] = kWriteFormat;
-  Put<uint16_t>(&h[105], kWriteRecordLength);
-  // Bytes 107-130, the legacy counts, stay zero: LAS 1.4 forbids them for
-  // formats 6-10.
+  Put<uint16_t>(&h[94], static_cast<uint16_t>(size));
+  Put<uint32_t>(&h[96], static_cast<uint32_t>(size + vlr_bytes));
+  Put<uint32_t>(&h[100], vlr_count);
+  h[104] = static_cast<uint8_t>(WriteFormat(options.version));
+  Put<uint16_t>(&h[105], static_cast<uint16_t>(record_length));
+  uint64_t by_return[15] = {};
+  for (const PointRecord& p : points) {
+    if (p.return_number >= 1) ++by_return[p.return_number - 1];
+  }
+  // LAS 1.4 forbids the legacy counts (bytes 107-130) for formats 6-10; LAS
+  // 1.2 has only them, returns 1-5.
+  if (v12) {
+    Put<uint32_t>(&h[107], static_cast<uint32_t>(points.size()));
+    for (int r = 0; r < 5; ++r) Put<uint32_t>(&h[111 + 4 * r], static_cast<uint32_t>(by_return[r]));
+  }
   for (int a = 0; a < 3; ++a) {
     Put<double>(&h[131 + 8 * a], q.scale[a]);
     Put<double>(&h[155 + 8 * a], q.offset[a]);
     Put<double>(&h[179 + 16 * a], q.hi[a]);
     Put<double>(&h[187 + 16 * a], q.lo[a]);
   }
-  Put<uint64_t>(&h[247], points.size());
-  uint64_t by_return[15] = {};
-  for (const PointRecord& p : points) {
-    if (p.return_number >= 1) ++by_return[p.return_number - 1];
+  if (!v12) {
+    Put<uint64_t>(&h[247], points.size());
+    for (int r = 0; r < 15; ++r) Put<uint64_t>(&h[255 + 8 * r], by_return[r]);
   }
-  for (int r = 0; r < 15; ++r) Put<uint64_t>(&h[255 + 8 * r], by_return[r]);
   return h;
 }
 
-std::vector<uint8_t> MakeWktVlr(const std::filesystem::path& path, const std::string& wkt) {
-  const size_t payload = wkt.size() + 1;  // the spec asks for a terminating NUL
-  if (payload > std::numeric_limits<uint16_t>::max()) {
-    throw Error(path.string() + ": CRS WKT has " + std::to_string(wkt.size()) +
-                " characters; expected at most 65534 to fit a LAS VLR");
+void AppendVlr(const std::filesystem::path& path, const char* user_id, uint16_t record_id,
+               const char* description, const std::vector<uint8_t>& payload,
+               std::vector<uint8_t>* out) {
+  if (payload.size() > std::numeric_limits<uint16_t>::max()) {
+    throw Error(path.string() + ": " + description + " takes " + std::to_string(payload.size()) +
+                " bytes; expected at most 65535 to fit a LAS VLR");
   }
-  std::vector<uint8_t> v(kVlrHeaderSize + payload, 0);
-  std::memcpy(&v[2], kProjectionUserId, sizeof kProjectionUserId - 1);
-  Put<uint16_t>(&v[18], kWktRecordId);
-  Put<uint16_t>(&v[20], static_cast<uint16_t>(payload));
-  std::snprintf(reinterpret_cast<char*>(&v[22]), 32, "%s", "OGC WKT coordinate system");
-  std::memcpy(&v[kVlrHeaderSize], wkt.data(), wkt.size());
-  return v;
+  std::vector<uint8_t> v(kVlrHeaderSize, 0);
+  std::memcpy(&v[2], user_id, std::strlen(user_id));
+  Put<uint16_t>(&v[18], record_id);
+  Put<uint16_t>(&v[20], static_cast<uint16_t>(payload.size()));
+  std::snprintf(reinterpret_cast<char*>(&v[22]), 32, "%s", description);
+  out->insert(out->end(), v.begin(), v.end());
+  out->insert(out->end(), payload.begin(), payload.end());
 }
 
-void EncodeFormat7(const PointRecord& p, const Quantization& q, uint8_t* out) {
-  std::memset(out, 0, kWriteRecordLength);
+// GeoTIFF keys (the GeoKeyDirectoryTag, LAS 1.2's way to give the CRS) for a
+// CRS with an EPSG code, projected or geographic, with its vertical CRS when
+// that has one; empty for any other CRS, which then has only its WKT.
+std::vector<uint8_t> GeoKeys(const std::string& wkt) {
+  OGRSpatialReference srs;
+  if (wkt.empty() || srs.importFromWkt(wkt.c_str()) != OGRERR_NONE) return {};
+  const bool projected = srs.IsProjected();
+  const char* horizontal = projected ? "PROJCS" : srs.IsGeographic() ? "GEOGCS" : nullptr;
+  if (horizontal == nullptr) return {};
+  auto code = [&](const char* node) -> int {
+    const char* authority = srs.GetAuthorityName(node);
+    const char* c = srs.GetAuthorityCode(node);
+    return authority && c && std::strcmp(authority, "EPSG") == 0 ? std::atoi(c) : 0;
+  };
+  const int h = code(horizontal);
+  if (h <= 0 || h > 65535) return {};
+  // {key, location 0 = the value itself, count 1, value}, by key.
+  std::vector<std::array<uint16_t, 4>> keys = {
+      {1024, 0, 1, static_cast<uint16_t>(projected ? 1 : 2)},  // GTModelType
+      {1025, 0, 1, 1},                                         // GTRasterType: PixelIsArea
+      {static_cast<uint16_t>(projected ? 3072 : 2048), 0, 1, static_cast<uint16_t>(h)}};
+  if (const int v = code("VERT_CS"); v > 0 && v <= 65535) {
+    keys.push_back({4096, 0, 1, static_cast<uint16_t>(v)});  // VerticalCSType
+  }
+  std::vector<uint8_t> out(8 * (keys.size() + 1));
+  const uint16_t directory[4] = {1, 1, 0, static_cast<uint16_t>(keys.size())};
+  std::memcpy(out.data(), directory, 8);
+  for (size_t k = 0; k < keys.size(); ++k) std::memcpy(&out[8 * (k + 1)], keys[k].data(), 8);
+  return out;
+}
+
+void EncodePoint(const PointRecord& p, const Quantization& q, int format, uint8_t* out) {
   Put<int32_t>(out + 0, Quantize(p.x, q.scale[0], q.offset[0]));
   Put<int32_t>(out + 4, Quantize(p.y, q.scale[1], q.offset[1]));
   Put<int32_t>(out + 8, Quantize(p.z, q.scale[2], q.offset[2]));
   Put<uint16_t>(out + 12, p.intensity);
-  out[14] = static_cast<uint8_t>((p.return_number & 0x0F) | (p.number_of_returns << 4));
-  out[16] = p.classification;
-  Put<uint16_t>(out + 30, p.r);
-  Put<uint16_t>(out + 32, p.g);
-  Put<uint16_t>(out + 34, p.b);
+  if (format < 6) {
+    out[14] = static_cast<uint8_t>((p.return_number & 0x07) | ((p.number_of_returns & 0x07) << 3));
+    out[15] = p.classification & 0x1F;
+  } else {
+    out[14] = static_cast<uint8_t>((p.return_number & 0x0F) | (p.number_of_returns << 4));
+    out[16] = p.classification;
+  }
+  Put<uint16_t>(out + kRgbOffset[format], p.r);
+  Put<uint16_t>(out + kRgbOffset[format] + 2, p.g);
+  Put<uint16_t>(out + kRgbOffset[format] + 4, p.b);
 }
 
 void DecodePoint(const uint8_t* p, int format, const LasCloud& cloud, PointRecord* out) {
@@ -226,9 +284,13 @@ void DecodePoint(const uint8_t* p, int format, const LasCloud& cloud, PointRecor
   }
 }
 
-bool IsWktRecord(const uint8_t* record_header) {
-  return FixedString(record_header + 2, 16) == kProjectionUserId &&
-         Get<uint16_t>(record_header + 18) == kWktRecordId;
+bool IsRecord(const uint8_t* record_header, const char* user_id, uint16_t record_id) {
+  return FixedString(record_header + 2, 16) == user_id &&
+         Get<uint16_t>(record_header + 18) == record_id;
+}
+bool IsWktRecord(const uint8_t* h) { return IsRecord(h, kProjectionUserId, kWktRecordId); }
+bool IsExtraBytesRecord(const uint8_t* h) {
+  return IsRecord(h, las::kSpecUserId, las::kExtraBytesRecordId);
 }
 
 // Reads `n` bytes at `pos`; the caller has checked that they lie in the file.
@@ -248,6 +310,14 @@ std::string WktFromPayload(const std::vector<uint8_t>& payload) {
 
 }  // namespace
 
+LasVersion ParseLasVersion(const std::string& text) {
+  if (text == "1.2") return LasVersion::k12;
+  if (text == "1.4") return LasVersion::k14;
+  throw Error("LAS version '" + text + "' (--las-version): expected 1.2 or 1.4");
+}
+
+std::string ToString(LasVersion version) { return version == LasVersion::k12 ? "1.2" : "1.4"; }
+
 std::string LasWriteOptions::Problem() const {
   if (!(scale >= 0) || !std::isfinite(scale)) {
     return "LAS scale " + Num(scale) + ": expected a positive resolution, or 0 to choose one";
@@ -265,11 +335,15 @@ std::string LasWriteOptions::Problem() const {
 }
 
 void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>& points,
-              const LasWriteOptions& options) {
+              const LasWriteOptions& options, const std::vector<LasExtraField>& extras) {
   if (const std::string problem = options.Problem(); !problem.empty()) {
     throw Error(path.string() + ": " + problem);
   }
-  CheckPoints(path, points);
+  CheckPoints(path, points, options.version);
+  if (const std::string problem = las::ExtraFieldsProblem(extras, points.size());
+      !problem.empty()) {
+    throw Error(path.string() + ": " + problem);
+  }
   const std::string wkt = CrsToWkt(options.crs);
   bool geographic = false;
   if (!wkt.empty()) {
@@ -290,25 +364,51 @@ void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>&
       q.hi[a] = std::max(q.hi[a], stored);
     }
   }
-  const std::vector<uint8_t> vlr = wkt.empty() ? std::vector<uint8_t>() : MakeWktVlr(path, wkt);
-  const std::vector<uint8_t> header = MakeHeader(points, q, vlr.size(), options);
+  std::vector<uint8_t> vlrs;
+  uint32_t vlr_count = 0;
+  if (options.version == LasVersion::k12) {
+    if (const std::vector<uint8_t> keys = GeoKeys(wkt); !keys.empty()) {
+      AppendVlr(path, kProjectionUserId, kGeoKeyRecordId, "GeoTIFF GeoKeyDirectoryTag", keys,
+                &vlrs);
+      ++vlr_count;
+    }
+  }
+  if (!wkt.empty()) {
+    // The spec asks for a terminating NUL.
+    AppendVlr(path, kProjectionUserId, kWktRecordId, "OGC WKT coordinate system",
+              std::vector<uint8_t>(wkt.c_str(), wkt.c_str() + wkt.size() + 1), &vlrs);
+    ++vlr_count;
+  }
+  if (!extras.empty()) {
+    AppendVlr(path, las::kSpecUserId, las::kExtraBytesRecordId, "Extra Bytes",
+              las::EncodeExtraDescriptors(extras), &vlrs);
+    ++vlr_count;
+  }
+  const int format = WriteFormat(options.version);
+  const size_t base = kMinRecordLength[format];
+  size_t record = base;
+  for (const LasExtraField& f : extras) record += las::ExtraTypeSize(f.type);
+  const std::vector<uint8_t> header =
+      MakeHeader(points, q, vlrs.size(), vlr_count, record, options);
 
   WriteStreamAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(header.data()), header.size());
-    out.write(reinterpret_cast<const char*>(vlr.data()), vlr.size());
-    std::vector<uint8_t> buf(kChunkPoints * kWriteRecordLength);
+    out.write(reinterpret_cast<const char*>(vlrs.data()), vlrs.size());
+    std::vector<uint8_t> buf(kChunkPoints * record);
     for (size_t first = 0; first < points.size(); first += kChunkPoints) {
       const size_t n = std::min(kChunkPoints, points.size() - first);
+      std::fill(buf.begin(), buf.end(), 0);
       for (size_t i = 0; i < n; ++i) {
-        EncodeFormat7(points[first + i], q, &buf[i * kWriteRecordLength]);
+        EncodePoint(points[first + i], q, format, &buf[i * record]);
+        las::EncodeExtraValues(extras, first + i, &buf[i * record + base]);
       }
       out.write(reinterpret_cast<const char*>(buf.data()),
-                static_cast<std::streamsize>(n * kWriteRecordLength));
+                static_cast<std::streamsize>(n * record));
     }
   });
 }
 
-LasCloud ReadLas(const std::filesystem::path& path) {
+LasCloud ReadLas(const std::filesystem::path& path, bool extra_values) {
   const std::string file = path.string();
   std::ifstream in = OpenInputFile(path, std::ios::binary);
   const uint64_t size = std::filesystem::file_size(path);
@@ -385,6 +485,7 @@ LasCloud ReadLas(const std::filesystem::path& path) {
   }
 
   uint64_t pos = header_size;
+  std::vector<las::ExtraFieldLayout> extra_layout;
   for (uint32_t i = 0; i < vlr_count; ++i) {
     if (pos + kVlrHeaderSize > point_offset) {
       throw fail("variable length record " + std::to_string(i + 1) + " of " +
@@ -400,6 +501,10 @@ LasCloud ReadLas(const std::filesystem::path& path) {
     }
     if (IsWktRecord(vh.data()) && cloud.crs_wkt.empty()) {
       cloud.crs_wkt = WktFromPayload(ReadAt(in, pos + kVlrHeaderSize, length, file));
+    }
+    if (IsExtraBytesRecord(vh.data()) && extra_layout.empty()) {
+      extra_layout = las::DecodeExtraDescriptors(ReadAt(in, pos + kVlrHeaderSize, length, file),
+                                                 record_length - kMinRecordLength[format_byte]);
     }
     pos += kVlrHeaderSize + length;
   }
@@ -426,6 +531,10 @@ LasCloud ReadLas(const std::filesystem::path& path) {
   }
 
   cloud.points.resize(count);
+  for (const las::ExtraFieldLayout& f : extra_layout) {
+    cloud.extras.push_back(f.field);
+    if (extra_values) cloud.extras.back().values.resize(count);
+  }
   std::vector<uint8_t> buf(kChunkPoints * record_length);
   in.seekg(static_cast<std::streamoff>(point_offset));
   for (uint64_t first = 0; first < count; first += kChunkPoints) {
@@ -435,77 +544,14 @@ LasCloud ReadLas(const std::filesystem::path& path) {
       throw fail("read failed in the point data near point " + std::to_string(first));
     }
     for (size_t i = 0; i < n; ++i) {
-      DecodePoint(&buf[i * record_length], format_byte, cloud, &cloud.points[first + i]);
-    }
-  }
-  return cloud;
-}
-
-void WriteXyz(const std::filesystem::path& path, const std::vector<PointRecord>& points,
-              int precision, bool rgb) {
-  if (precision < 0 || precision > 17) {
-    throw Error(path.string() + ": XYZ precision " + std::to_string(precision) +
-                " (expected 0-17 decimals)");
-  }
-  CheckPoints(path, points);
-  WriteStreamAtomically(path, [&](std::ostream& out) {
-    char line[256];
-    for (const PointRecord& p : points) {
-      int n = std::snprintf(line, sizeof line, "%.*f %.*f %.*f", precision, p.x, precision, p.y,
-                            precision, p.z);
-      if (rgb && n > 0 && n < static_cast<int>(sizeof line)) {
-        n += std::snprintf(line + n, sizeof line - n, " %d %d %d", ColorTo8(p.r), ColorTo8(p.g),
-                           ColorTo8(p.b));
-      }
-      if (n < 0 || n >= static_cast<int>(sizeof line)) {
-        throw Error(path.string() + ": point (" + Num(p.x) + ", " + Num(p.y) + ", " + Num(p.z) +
-                    ") does not fit an XYZ line");
-      }
-      line[n] = '\n';
-      out.write(line, n + 1);
-    }
-  });
-}
-
-XyzCloud ReadXyz(const std::filesystem::path& path) {
-  TextLines lines(path);
-  XyzCloud cloud;
-  std::string line;
-  size_t fields = 0;
-  int layout_line = 0;
-  constexpr const char* kNames[6] = {"X", "Y", "Z", "R", "G", "B"};
-  while (lines.NextRaw(&line)) {
-    std::replace(line.begin(), line.end(), ',', ' ');
-    const std::vector<std::string> tokens = SplitWhitespace(line);
-    if (tokens.empty()) continue;
-    if (fields == 0) {
-      if (tokens.size() != 3 && tokens.size() != 6) {
-        throw lines.Fail("expected 3 fields (X Y Z) or 6 (X Y Z R G B), got " +
-                         std::to_string(tokens.size()));
-      }
-      fields = tokens.size();
-      layout_line = lines.line();
-      cloud.has_rgb = fields == 6;
-    } else if (tokens.size() != fields) {
-      throw lines.Fail("expected " + std::to_string(fields) + " fields like line " +
-                       std::to_string(layout_line) + ", got " + std::to_string(tokens.size()));
-    }
-    PointRecord p;
-    p.x = lines.Double(tokens[0], kNames[0]);
-    p.y = lines.Double(tokens[1], kNames[1]);
-    p.z = lines.Double(tokens[2], kNames[2]);
-    if (cloud.has_rgb) {
-      uint16_t* channel[3] = {&p.r, &p.g, &p.b};
-      for (int c = 0; c < 3; ++c) {
-        const int v = lines.Int(tokens[3 + c], kNames[3 + c]);
-        if (v < 0 || v > 255) {
-          throw lines.Fail("expected 8-bit colour 0-255 for " + std::string(kNames[3 + c]) +
-                           ", got " + tokens[3 + c]);
-        }
-        *channel[c] = ColorTo16(static_cast<uint8_t>(v));
+      const uint8_t* record = &buf[i * record_length];
+      DecodePoint(record, format_byte, cloud, &cloud.points[first + i]);
+      if (!extra_values) continue;
+      for (size_t k = 0; k < extra_layout.size(); ++k) {
+        cloud.extras[k].values[first + i] =
+            las::DecodeExtraValue(extra_layout[k], record + kMinRecordLength[format_byte]);
       }
     }
-    cloud.points.push_back(p);
   }
   return cloud;
 }

@@ -124,10 +124,21 @@ struct PlyHeader {
 
 Role RoleOf(const std::string& name) {
   static const std::pair<const char*, Role> kRoles[] = {
-      {"x", Role::kX},         {"y", Role::kY},         {"z", Role::kZ},
-      {"nx", Role::kNx},       {"ny", Role::kNy},       {"nz", Role::kNz},
-      {"red", Role::kRed},     {"green", Role::kGreen}, {"blue", Role::kBlue},
-      {"score", Role::kScore}, {"views", Role::kViews}};
+      {"x", Role::kX},
+      {"y", Role::kY},
+      {"z", Role::kZ},
+      {"nx", Role::kNx},
+      {"ny", Role::kNy},
+      {"nz", Role::kNz},
+      {"red", Role::kRed},
+      {"green", Role::kGreen},
+      {"blue", Role::kBlue},
+      {"score", Role::kScore},
+      {"views", Role::kViews},
+      // What sapmvs writes since CloudCompare's command line keeps only
+      // `scalar_*` properties; the plain names are what it wrote before.
+      {"scalar_score", Role::kScore},
+      {"scalar_views", Role::kViews}};
   for (const auto& [n, r] : kRoles) {
     if (name == n) return r;
   }
@@ -517,11 +528,11 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud) {
     record += 3;
   }
   if (cloud.has_scores) {
-    header << "property float score\n";
+    header << "property float scalar_score\n";
     record += 4;
   }
   if (cloud.has_views) {
-    header << "property " << (views_fit_uchar ? "uchar" : "int") << " views\n";
+    header << "property " << (views_fit_uchar ? "uchar" : "int") << " scalar_views\n";
     record += views_fit_uchar ? 1 : 4;
   }
   header << "end_header\n";

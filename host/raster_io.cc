@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <sstream>
 
@@ -102,6 +103,71 @@ void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const 
   if (QuietGdalErrors::Failed()) throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
 }
 
+// RGBA, 8 bit, interleaved per pixel, on `grid`'s geotransform: photometric
+// RGB with an alpha band, so GIS shows nodata as transparent.
+void WriteRgbaTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& grid,
+                   const OGRSpatialReference* srs, const std::vector<uint8_t>& rgba) {
+  GDALAllRegister();
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (!driver) throw Error(file + ": GDAL has no GTiff driver");
+  QuietGdalErrors quiet;
+  CPLStringList options;
+  options.SetNameValue("COMPRESS", "DEFLATE");
+  options.SetNameValue("PHOTOMETRIC", "RGB");
+  options.SetNameValue("ALPHA", "YES");
+  options.SetNameValue("TILED", "YES");
+  DatasetPtr ds(
+      driver->Create(tmp.string().c_str(), grid.width, grid.height, 4, GDT_Byte, options.List()));
+  if (!ds) throw Error(file + ": cannot create GeoTIFF" + quiet.Detail());
+  double geo[6] = {grid.origin_x, grid.cell_size, 0, grid.origin_y, 0, -grid.cell_size};
+  if (ds->SetGeoTransform(geo) != CE_None || (srs && ds->SetSpatialRef(srs) != CE_None) ||
+      ds->RasterIO(GF_Write, 0, 0, grid.width, grid.height, const_cast<uint8_t*>(rgba.data()),
+                   grid.width, grid.height, GDT_Byte, 4, nullptr, 4, 4 * grid.width,
+                   1) != CE_None) {
+    throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+  }
+  CPLErrorReset();
+  ds.reset();
+  if (QuietGdalErrors::Failed()) throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+}
+
+OGRSpatialReference SpatialRefOf(const std::filesystem::path& path, const std::string& crs) {
+  OGRSpatialReference srs;
+  if (!crs.empty()) {
+    try {
+      srs.importFromWkt(CrsToWkt(crs).c_str());
+    } catch (const Error& e) {
+      throw Error(path.string() + ": " + e.what());
+    }
+  }
+  return srs;
+}
+
+// Runs `write(tmp)` and commits the file. GDAL keeps what GeoTIFF tags cannot
+// hold (a CRS without GeoTIFF keys) in a side-car beside the file it wrote.
+// It must follow the rename, and a stale one left by an earlier file at
+// `path` must not describe this one.
+void CommitTiff(const std::filesystem::path& path,
+                const std::function<void(const std::filesystem::path& tmp)>& write) {
+  AtomicFile out(path);
+  const std::filesystem::path temp_aux = out.temp_path().string() + ".aux.xml";
+  const std::filesystem::path aux = path.string() + ".aux.xml";
+  std::error_code ec;
+  try {
+    write(out.temp_path());
+    out.Commit();
+  } catch (...) {
+    std::filesystem::remove(temp_aux, ec);
+    throw;
+  }
+  if (std::filesystem::exists(temp_aux, ec)) {
+    std::filesystem::rename(temp_aux, aux, ec);
+    if (ec) throw Error(aux.string() + ": cannot write GDAL side-car (" + ec.message() + ")");
+  } else {
+    std::filesystem::remove(aux, ec);
+  }
+}
+
 }  // namespace
 
 bool GeoRaster::IsEmpty(int col, int row) const {
@@ -149,35 +215,44 @@ CrsIdentity IdentifyCrs(const std::string& crs) {
 
 void WriteGeoTiff(const std::filesystem::path& path, const GeoRaster& raster) {
   CheckRaster(path, raster);
-  const std::string file = path.string();
+  const OGRSpatialReference srs = SpatialRefOf(path, raster.crs);
+  CommitTiff(path, [&](const std::filesystem::path& tmp) {
+    WriteTiff(path.string(), tmp, raster, raster.crs.empty() ? nullptr : &srs);
+  });
+}
+
+void WriteColorGeoTiff(const std::filesystem::path& path, const GeoRaster& grid,
+                       const std::vector<uint8_t>& rgba) {
+  GeoRaster shape = grid;
+  shape.values.assign(static_cast<size_t>(std::max(0, grid.width)) * std::max(0, grid.height), 0);
+  CheckRaster(path, shape);
+  if (rgba.size() != 4 * shape.values.size()) {
+    throw Error(path.string() + ": " + std::to_string(rgba.size()) + " RGBA bytes for " +
+                std::to_string(grid.width) + " x " + std::to_string(grid.height) +
+                " pixels (expected 4 per pixel)");
+  }
+  const OGRSpatialReference srs = SpatialRefOf(path, grid.crs);
+  CommitTiff(path, [&](const std::filesystem::path& tmp) {
+    WriteRgbaTiff(path.string(), tmp, grid, grid.crs.empty() ? nullptr : &srs, rgba);
+  });
+}
+
+std::string CrsLinearUnit(const std::string& crs) {
+  if (crs.empty()) return "";
   OGRSpatialReference srs;
-  if (!raster.crs.empty()) {
-    try {
-      srs.importFromWkt(CrsToWkt(raster.crs).c_str());
-    } catch (const Error& e) {
-      throw Error(file + ": " + e.what());
-    }
-  }
-  AtomicFile out(path);
-  // GDAL keeps what GeoTIFF tags cannot hold (a CRS without GeoTIFF keys) in
-  // a side-car beside the file it wrote. It must follow the rename, and a
-  // stale one left by an earlier file at `path` must not describe this one.
-  const std::filesystem::path temp_aux = out.temp_path().string() + ".aux.xml";
-  const std::filesystem::path aux = path.string() + ".aux.xml";
-  std::error_code ec;
   try {
-    WriteTiff(file, out.temp_path(), raster, raster.crs.empty() ? nullptr : &srs);
-    out.Commit();
-  } catch (...) {
-    std::filesystem::remove(temp_aux, ec);
-    throw;
+    if (srs.importFromWkt(CrsToWkt(crs).c_str()) != OGRERR_NONE) return "";
+  } catch (const Error&) {
+    return "";
   }
-  if (std::filesystem::exists(temp_aux, ec)) {
-    std::filesystem::rename(temp_aux, aux, ec);
-    if (ec) throw Error(aux.string() + ": cannot write GDAL side-car (" + ec.message() + ")");
-  } else {
-    std::filesystem::remove(aux, ec);
-  }
+  if (srs.IsGeographic()) return "deg";
+  if (!srs.IsProjected() && !srs.IsLocal()) return "";
+  const char* name = nullptr;
+  const double to_metre = srs.GetLinearUnits(&name);
+  if (std::abs(to_metre - 1) < 1e-12) return "m";
+  if (std::abs(to_metre - 0.3048) < 1e-12) return "ft";
+  if (std::abs(to_metre - 1200.0 / 3937.0) < 1e-12) return "ftUS";
+  return name ? name : "";
 }
 
 GeoRaster ReadGeoRaster(const std::filesystem::path& path) {

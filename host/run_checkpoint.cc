@@ -58,8 +58,9 @@ void RemoveCheckpoints(const std::filesystem::path& dir) {
 
 void RemoveRunOutputs(const std::filesystem::path& out) {
   std::error_code ec;
-  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm.tif.aux.xml", "dsm.png",
-                        "report.json", "profile.csv", "profile.json"}) {
+  for (const char* f :
+       {"cloud.ply", "cloud.las", "dsm.tif", "dsm.tif.aux.xml", "dsm.png", "dsm.pgw",
+        "dsm_color.tif", "dsm_color.tif.aux.xml", "report.json", "profile.csv", "profile.json"}) {
     std::filesystem::remove(out / f, ec);
   }
   RemoveCheckpoints(out / "groups");

@@ -29,20 +29,25 @@ else
   echo "install-deps: done"
 fi
 
-# The independent LAS reader the tests check cloud.las with (copc.js, from
-# npm): into build/npm, never system-wide. Without the npm registry the LAS
-# test says skipped; nothing else needs it.
+# The independent LAS readers the tests check cloud.las with, from npm: copc.js
+# and @loaders.gl/las (the loader behind deck.gl and kepler.gl; @loaders.gl/las
+# 4.4.x asks for @loaders.gl/core ~4.4.0, so both are pinned to 4.4.5). Into
+# build/npm, never system-wide. Without the npm registry the LAS test says
+# skipped; nothing else needs them.
 # Node and npm only for that test, so a failure here does not stop the build.
 if ! command -v npm >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm \
     >/dev/null 2>&1 || echo "install-deps: warning: could not install nodejs/npm"
 fi
 cd "$(dirname "$0")/.."
-if command -v npm >/dev/null 2>&1 && [ ! -d build/npm/node_modules/copc ]; then
+NPM_PACKAGES=(copc@0.0.8 @loaders.gl/core@4.4.5 @loaders.gl/las@4.4.5)
+if command -v npm >/dev/null 2>&1 &&
+  { [ ! -d build/npm/node_modules/copc ] || [ ! -d build/npm/node_modules/@loaders.gl/las ]; }; then
   mkdir -p build/npm
-  if npm install --prefix build/npm --no-audit --no-fund --loglevel=error copc@0.0.8 >/dev/null 2>&1; then
-    echo "install-deps: copc.js (LAS reader for the tests) in build/npm"
+  if npm install --prefix build/npm --no-audit --no-fund --loglevel=error "${NPM_PACKAGES[@]}" \
+    >/dev/null 2>&1; then
+    echo "install-deps: copc.js and @loaders.gl/las (LAS readers for the tests) in build/npm"
   else
-    echo "install-deps: warning: npm could not install copc.js; the independent LAS test will be skipped"
+    echo "install-deps: warning: npm could not install ${NPM_PACKAGES[*]}; the independent LAS test will be skipped"
   fi
 fi

@@ -113,23 +113,5 @@ TEST(CloudDsm, BadOptionsAndEmptyCloudsAreErrors) {
   EXPECT_THROW(RasterizeDsm(c, o), Error);
 }
 
-class CloudDsmFiles : public test::ScratchTest {};
-
-TEST_F(CloudDsmFiles, ReliefPngIsWrittenWhole) {
-  const PointCloud c = PlaneCloud(30, 20, 0.5, 0, 0);
-  const GeoRaster r = RasterizeDsm(c, DsmOptions{});
-  const auto path = dir_ / "dsm.png";
-  WriteReliefPng(path, r);
-  ASSERT_TRUE(std::filesystem::exists(path));
-  std::ifstream f(path, std::ios::binary);
-  char magic[8] = {};
-  f.read(magic, 8);
-  EXPECT_EQ(std::string(magic + 1, 3), "PNG");
-  GeoRaster none = r;
-  for (float& v : none.values) v = std::nanf("");
-  EXPECT_THROW(WriteReliefPng(dir_ / "none.png", none), Error);
-  EXPECT_FALSE(std::filesystem::exists(dir_ / "none.png"));
-}
-
 }  // namespace
 }  // namespace sapmvs

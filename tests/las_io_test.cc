@@ -72,6 +72,14 @@ std::vector<PointRecord> RandomUtmPoints(int n, unsigned seed) {
   return points;
 }
 
+// The layout most tests check byte by byte, and the one RandomUtmPoints'
+// returns (up to 15) and classes (up to 255) need.
+LasWriteOptions V14() {
+  LasWriteOptions o;
+  o.version = LasVersion::k14;
+  return o;
+}
+
 // Expects `f` to throw an InputError for `path` (line 0) whose message
 // contains `expected`.
 template <typename F>
@@ -90,7 +98,7 @@ void ExpectInputError(F f, const fs::path& path, const std::string& expected) {
 TEST_F(LasIoTest, RandomUtmPointsRoundTripWithinTheScale) {
   const fs::path path = dir_ / "cloud.las";
   const std::vector<PointRecord> points = RandomUtmPoints(1001, 7);
-  WriteLas(path, points);
+  WriteLas(path, points, V14());
   const LasCloud cloud = ReadLas(path);
   ASSERT_EQ(cloud.points.size(), points.size());
   EXPECT_EQ(cloud.version_major, 1);
@@ -123,7 +131,7 @@ TEST_F(LasIoTest, RgbRoundTripsExactly) {
     points[i].g = colours[i][1];
     points[i].b = colours[i][2];
   }
-  WriteLas(path, points);
+  WriteLas(path, points, V14());
   const LasCloud cloud = ReadLas(path);
   ASSERT_EQ(cloud.points.size(), 5u);
   for (int i = 0; i < 5; ++i) {
@@ -137,7 +145,7 @@ TEST_F(LasIoTest, RgbRoundTripsExactly) {
 
 TEST_F(LasIoTest, CrsRoundTripsAsWktOfTheSameCrs) {
   const fs::path path = dir_ / "utm.las";
-  LasWriteOptions options;
+  LasWriteOptions options = V14();
   options.crs = "EPSG:32632";
   ASSERT_TRUE(options.Check()) << options.Problem();
   WriteLas(path, RandomUtmPoints(10, 1), options);
@@ -153,7 +161,7 @@ TEST_F(LasIoTest, CrsRoundTripsAsWktOfTheSameCrs) {
 TEST_F(LasIoTest, HeaderBytesFollowLas14Format7) {
   const fs::path path = dir_ / "header.las";
   const std::vector<PointRecord> points = RandomUtmPoints(93, 3);
-  LasWriteOptions options;
+  LasWriteOptions options = V14();
   options.crs = "EPSG:32632";
   WriteLas(path, points, options);
   const Bytes b = ReadBytes(path);
@@ -217,7 +225,7 @@ TEST_F(LasIoTest, HeaderBytesFollowLas14Format7) {
 
 TEST_F(LasIoTest, WithoutCrsThereIsNoVlr) {
   const fs::path path = dir_ / "plain.las";
-  WriteLas(path, RandomUtmPoints(7, 5));
+  WriteLas(path, RandomUtmPoints(7, 5), V14());
   const Bytes b = ReadBytes(path);
   EXPECT_EQ(Field<uint32_t>(b, 100), 0u);
   EXPECT_EQ(Field<uint32_t>(b, 96), 375u);
@@ -226,7 +234,7 @@ TEST_F(LasIoTest, WithoutCrsThereIsNoVlr) {
 
 TEST_F(LasIoTest, EmptyCloudRoundTrips) {
   const fs::path path = dir_ / "empty.las";
-  WriteLas(path, {});
+  WriteLas(path, {}, V14());
   EXPECT_EQ(fs::file_size(path), 375u);
   EXPECT_TRUE(ReadLas(path).points.empty());
 }
@@ -237,7 +245,7 @@ TEST_F(LasIoTest, ScaleCoarsensOnlyWhereTheExtentNeedsIt) {
   points[0].x = 0;
   points[1].x = 1e7;  // 1e7 mm would overflow int32
   points[1].y = 1000;
-  WriteLas(path, points);
+  WriteLas(path, points, V14());
   const LasCloud cloud = ReadLas(path);
   EXPECT_EQ(cloud.scale[0], 0.01);
   EXPECT_EQ(cloud.scale[1], 0.001);
@@ -262,7 +270,7 @@ TEST_F(LasIoTest, GeographicCrsGetsAFineHorizontalScale) {
     points[i].y = 48.7 + 0.002 * i;
     points[i].z = 300 + i;
   }
-  LasWriteOptions options;
+  LasWriteOptions options = V14();
   options.crs = "EPSG:4326";
   WriteLas(path, points, options);
   const LasCloud cloud = ReadLas(path);
@@ -273,7 +281,7 @@ TEST_F(LasIoTest, GeographicCrsGetsAFineHorizontalScale) {
 }
 
 TEST_F(LasIoTest, BadOptionsAreReported) {
-  LasWriteOptions options;
+  LasWriteOptions options = V14();
   options.scale = -1;
   EXPECT_FALSE(options.Check());
   EXPECT_NE(options.Problem().find("-1"), std::string::npos) << options.Problem();
@@ -290,7 +298,7 @@ TEST_F(LasIoTest, NonFiniteCoordinatesAreRefusedWithNoFileLeft) {
   std::vector<PointRecord> points = RandomUtmPoints(20, 2);
   points[13].z = std::numeric_limits<double>::quiet_NaN();
   try {
-    WriteLas(path, points);
+    WriteLas(path, points, V14());
     FAIL() << "expected sapmvs::Error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
@@ -403,7 +411,7 @@ TEST_F(LasIoTest, HandBuiltLas12Formats0To3AreRead) {
 
 TEST_F(LasIoTest, WktInAnEvlrIsRead) {
   const fs::path path = dir_ / "evlr.las";
-  WriteLas(path, RandomUtmPoints(7, 9));
+  WriteLas(path, RandomUtmPoints(7, 9), V14());
   Bytes b = ReadBytes(path);
   OGRSpatialReference srs;
   ASSERT_EQ(srs.SetFromUserInput("EPSG:25833"), OGRERR_NONE);
@@ -430,7 +438,7 @@ class LasMalformedTest : public LasIoTest {
   // A valid file to break.
   Bytes Valid() {
     const fs::path path = dir_ / "valid.las";
-    WriteLas(path, RandomUtmPoints(93, 4));
+    WriteLas(path, RandomUtmPoints(93, 4), V14());
     return ReadBytes(path);
   }
   fs::path Write(const Bytes& b) {
@@ -507,7 +515,7 @@ TEST_F(LasMalformedTest, UnsupportedVersion) {
 }
 
 TEST_F(LasMalformedTest, VlrRunningIntoThePoints) {
-  LasWriteOptions options;
+  LasWriteOptions options = V14();
   options.crs = "EPSG:32632";
   const fs::path valid = dir_ / "crs.las";
   WriteLas(valid, RandomUtmPoints(3, 4), options);

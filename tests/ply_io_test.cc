@@ -110,7 +110,7 @@ TEST_F(PlyIoTest, WrittenBytesFollowTheSpecification) {
   EXPECT_EQ(header.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u) << header;
   EXPECT_NE(header.find("element vertex 3\nproperty double x\nproperty double y\n"
                         "property double z\nproperty uchar red\nproperty uchar green\n"
-                        "property uchar blue\nproperty uchar views\n"),
+                        "property uchar blue\nproperty uchar scalar_views\n"),
             std::string::npos)
       << header;
   // x y z (3 doubles) + RGB + views = 28 bytes per vertex.
@@ -129,7 +129,7 @@ TEST_F(PlyIoTest, ViewCountsAbove255AreWrittenAsInt) {
   const fs::path path = dir_ / "cloud.ply";
   WritePly(path, cloud);
   const Bytes b = ReadBytes(path);
-  EXPECT_NE(std::string(b.begin(), b.end()).find("property int views\n"), std::string::npos);
+  EXPECT_NE(std::string(b.begin(), b.end()).find("property int scalar_views\n"), std::string::npos);
   EXPECT_EQ(ReadPly(path).points[4].num_views, 1000);
 }
 
@@ -254,6 +254,29 @@ TEST_F(PlyIoTest, ReadsBigEndianBuiltByHand) {
     EXPECT_EQ(c.points[i].num_views, 3 + i);
   }
   EXPECT_TRUE(c.has_colors && c.has_scores && c.has_views);
+}
+
+// As CloudCompare writes its scalar fields (float, `scalar_` names) and as
+// sapmvs writes them; the big-endian test above reads the plain names.
+TEST_F(PlyIoTest, ScalarPrefixedScoreAndViewsAreRead) {
+  const fs::path path = dir_ / "cc.ply";
+  WriteText(path,
+            "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
+            "property double z\nproperty float scalar_score\nproperty float scalar_views\n"
+            "end_header\n1 2 3 0.5 4\n4 5 6 -0.25 7\n");
+  const PointCloud c = ReadPly(path);
+  ASSERT_EQ(c.points.size(), 2u);
+  EXPECT_TRUE(c.has_scores && c.has_views);
+  EXPECT_EQ(c.points[1].score, -0.25f);
+  EXPECT_EQ(c.points[1].num_views, 7);
+  // And what the writer declares.
+  PointCloud w = RandomCloud(2, 5);
+  WritePly(path, w);
+  const Bytes b = ReadBytes(path);
+  const std::string text(b.begin(), b.end());
+  EXPECT_NE(text.find("property float scalar_score\nproperty uchar scalar_views\n"),
+            std::string::npos);
+  EXPECT_EQ(text.find(" score\n"), std::string::npos);
 }
 
 TEST_F(PlyIoTest, MalformedHeadersNameTheLine) {

@@ -1,6 +1,6 @@
 #pragma once
-// What a merged cloud is turned into for users: a DSM raster (GeoTIFF), a
-// colour-relief picture of it, and the paper's cloud statistics (Tables 4, 6
+// What a merged cloud is turned into for users: a DSM raster (GeoTIFF; its
+// pictures are dsm_picture.h's), and the paper's cloud statistics (Tables 4, 6
 // and 8: average distance between points, density).
 
 #include <cstddef>
@@ -43,10 +43,5 @@ CloudFootprint MeasureFootprint(const PointCloud& cloud, double cell_size);
 // raster over 2^28 cells (a cell size far too small for the extent).
 GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options,
                        double* cell_size_used = nullptr);
-
-// Colour relief (low blue to high red, over the 1-99 % height range) shaded
-// by a hillshade (sun from the north-west, 45 degrees up), nodata light grey;
-// PNG, written atomically.
-void WriteReliefPng(const std::filesystem::path& path, const GeoRaster& dsm);
 
 }  // namespace sapmvs

@@ -4,8 +4,10 @@
 // group is matched (matcher.h) and checkpointed to DIR/groups/, and the group
 // clouds are merged (cloud_merge.h) into
 //   DIR/cloud.ply    binary, world coordinates in double, CRS in the header
-//   DIR/cloud.las    LAS 1.4 with RGB and the block's CRS
-//   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h), DIR/dsm.png its colour relief
+//   DIR/cloud.las    LAS 1.2 or 1.4 with RGB, score, views and normals
+//                    (cloud_las.h) and the block's CRS
+//   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h); its pictures (dsm_picture.h):
+//                    DIR/dsm_color.tif (georeferenced), DIR/dsm.png + dsm.pgw
 //   DIR/report.json  provenance (version, commit, command line, times,
 //                    machine, device), CRS and bounds, points, groups,
 //                    per-stage times, kernels, the paper's statistics
@@ -24,6 +26,7 @@
 #include "sapmvs/cloud_dsm.h"
 #include "sapmvs/cloud_merge.h"
 #include "sapmvs/grouping.h"
+#include "sapmvs/las_io.h"
 #include "sapmvs/matcher.h"
 
 namespace sapmvs {
@@ -47,6 +50,8 @@ struct RunOptions {
   // ground sample distances of the matched level. > 0.
   double merge_radius_gsd = 1.0;
   DsmOptions dsm;
+  // cloud.las: LAS 1.2 by default, which every reader opens (las_io.h).
+  LasVersion las_version = LasWriteOptions{}.version;
   // Profile the device queue (CL_QUEUE_PROFILING_ENABLE): kernel device
   // times in the report, and the profile tables (run_profile.h).
   bool profile = false;

@@ -131,14 +131,20 @@ struct EvaluationReport {
   std::vector<ErrorRow> rows;
   // DSM with --footprint or --block.
   std::optional<Completeness> completeness;
+  // The horizontal unit of the inputs' CRS, for the plots' axes (raster_io.h
+  // CrsLinearUnit; "" when neither the reference nor the cloud has a CRS).
+  std::string unit;
   // Per cloud point: position and dz (NaN without a reference height).
   std::vector<Eigen::Vector3d> points;
   std::vector<double> dz;
 };
 
-// Reads the XYZ of a cloud (.ply, .las, .xyz/.txt). Throws sapmvs::Error
-// (InputError for malformed files) naming the file; an empty cloud is an error.
-std::vector<Eigen::Vector3d> ReadCloudPositions(const std::filesystem::path& path);
+// Reads the XYZ of a cloud (.ply, .las, .xyz/.txt), and its CRS into `crs`
+// when given (PLY's comment, LAS's WKT; "" when there is none). Throws
+// sapmvs::Error (InputError for malformed files) naming the file; an empty
+// cloud is an error.
+std::vector<Eigen::Vector3d> ReadCloudPositions(const std::filesystem::path& path,
+                                                std::string* crs = nullptr);
 
 // The LiDAR protocol for points in memory; options.cloud / reference only
 // label the report, which keeps `cloud` for the plots. Throws sapmvs::Error

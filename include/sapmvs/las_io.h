@@ -29,6 +29,57 @@ struct PointRecord {
 inline uint16_t ColorTo16(uint8_t c) { return static_cast<uint16_t>(c * 257); }
 inline uint8_t ColorTo8(uint16_t c) { return static_cast<uint8_t>((c + 128u) / 257u); }
 
+// Which LAS a writer produces.
+enum class LasVersion {
+  // LAS 1.2, point data record format 2 (XYZ, intensity, returns, class, RGB;
+  // 26 bytes). Every LAS reader opens it: @loaders.gl/las (deck.gl, kepler.gl)
+  // refuses versions above 1.3, and formats 0-3 are all that LAS 1.2 readers
+  // know. Format 2 rather than 3: a dense cloud has no GPS time to store.
+  // Returns and number of returns at most 7, classes at most 31; the CRS as
+  // GeoTIFF keys (LASF_Projection/34735) when it has an EPSG code, and as WKT
+  // (2112) always.
+  k12,
+  // LAS 1.4, point data record format 7 (the same and GPS time, 36 bytes),
+  // the CRS as WKT only, as LAS 1.4 asks for formats 6-10.
+  k14,
+};
+
+// "1.2" or "1.4"; throws sapmvs::Error naming `text` and what is accepted.
+LasVersion ParseLasVersion(const std::string& text);
+std::string ToString(LasVersion version);
+
+// The value types of LAS Extra Bytes (the `data_type` of an Extra Bytes
+// descriptor, LAS 1.4 R15 table "Values for data_type"; the deprecated
+// array types 11-30 are not written).
+enum class LasExtraType : uint8_t {
+  kUint8 = 1,
+  kInt8 = 2,
+  kUint16 = 3,
+  kInt16 = 4,
+  kUint32 = 5,
+  kInt32 = 6,
+  kUint64 = 7,
+  kInt64 = 8,
+  kFloat32 = 9,
+  kFloat64 = 10,
+};
+
+// One per-point attribute stored as LAS Extra Bytes: the bytes after the
+// point format's own, described by one 192-byte descriptor in the Extra Bytes
+// VLR (LASF_Spec/4). LAS 1.4 formalised that VLR for a practice older
+// versions already allowed (records longer than their format), so 1.2 files
+// carry it too; readers that do not know it skip the bytes by the record
+// length.
+struct LasExtraField {
+  std::string name;         // 1-32 characters, unique within a file
+  std::string description;  // at most 32 characters
+  LasExtraType type = LasExtraType::kFloat32;
+  // One value per point, as the caller means it (no scale or offset). The
+  // writer refuses values the type cannot hold exactly (a fraction or an
+  // out-of-range count in an integer type, a non-finite value).
+  std::vector<double> values;
+};
+
 struct LasWriteOptions {
   // The CRS of the coordinates: WKT, "EPSG:n" or a PROJ string; empty = none.
   // Stored as WKT (OGRSpatialReference::SetFromUserInput + exportToWkt).
@@ -41,23 +92,29 @@ struct LasWriteOptions {
   // Synthetic data sets fix them so that the same inputs give the same bytes.
   int creation_day = 0;
   int creation_year = 0;
+  LasVersion version = LasVersion::k12;
 
   // Empty when the options are usable, else one line naming the bad value.
   std::string Problem() const;
   bool Check() const { return Problem().empty(); }
 };
 
-// Writes LAS 1.4, point data record format 7 (XYZ, intensity, returns, class,
-// RGB; 36 bytes), atomically. Per axis, the offset is the rounded centre of the
-// data. The header's bounding box is that of the stored (quantized)
-// coordinates. With a CRS the file has a WKT VLR (LASF_Projection/2112).
-// The WKT bit of the global encoding is always set, as LAS 1.4 requires for
-// formats 6-10, and the legacy 32-bit point counts are zero, as LAS 1.4
-// requires for formats 6-10; the 64-bit counts are always filled.
-// Throws sapmvs::Error naming `path` and the point or value at fault (for
-// instance a non-finite coordinate) before anything is written.
+// Writes `options.version` (see LasVersion), atomically, with `extras` as
+// Extra Bytes after each point's record, in the order given, and their
+// descriptors in an Extra Bytes VLR. Per axis, the offset is the rounded
+// centre of the data. The header's bounding box is that of the stored
+// (quantized) coordinates. LAS 1.4: the WKT bit of the global encoding is set
+// and the legacy 32-bit point counts are zero, as LAS 1.4 requires for formats
+// 6-10; the 64-bit counts are always filled. LAS 1.2: the 32-bit counts, so at
+// most 2^32 - 1 points. Extra Bytes descriptors of floating-point fields carry
+// the field's min and max (options bits 1 and 2); those of integer fields
+// carry none, since revisions of LAS 1.4 disagree on how an integer field's
+// min and max are stored (as double, or widened to 64-bit integers).
+// Throws sapmvs::Error naming `path` and the point, field or value at fault
+// (a non-finite coordinate, a return number the version cannot hold, a value
+// its field's type cannot) before anything is written.
 void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>& points,
-              const LasWriteOptions& options = {});
+              const LasWriteOptions& options = {}, const std::vector<LasExtraField>& extras = {});
 
 struct LasCloud {
   std::vector<PointRecord> points;
@@ -66,15 +123,23 @@ struct LasCloud {
   bool has_rgb = false;  // formats 2, 3, 5, 7, 8, 10; else r g b are 0
   std::array<double, 3> scale{}, offset{};
   std::string crs_wkt;  // from a WKT VLR or EVLR; empty when there is none
+  // The fields of an Extra Bytes VLR, in record order; `values` (scale and
+  // offset applied) only when ReadLas was asked for them.
+  std::vector<LasExtraField> extras;
 };
 
-// Reads LAS 1.0-1.4, uncompressed, point formats 0-10 (extra bytes in longer
-// records are skipped). Classification of formats 0-5 is the low 5 bits (the
-// class, without the synthetic/key-point/withheld flags). GeoTIFF-key CRSs
-// are not translated: crs_wkt stays empty for them.
+// Reads LAS 1.0-1.4, uncompressed, point formats 0-10. Classification of
+// formats 0-5 is the low 5 bits (the class, without the synthetic/key-point/
+// withheld flags). Extra Bytes described by an Extra Bytes VLR (LASF_Spec/4)
+// are listed in `extras`, and their values read when `extra_values` (a LiDAR
+// reference does not need them, and they can cost more memory than the
+// points); undescribed extra bytes are skipped. A descriptor of a reserved
+// type ends the list there, and a VLR that describes more bytes than the
+// records hold is ignored, as LAS 1.4 R15 says ("extra bytes mismatch").
+// GeoTIFF-key CRSs are not translated: crs_wkt stays empty for them.
 // Throws sapmvs::InputError naming the file and what was expected when it is
 // not LAS, truncated, LAZ-compressed or of an unknown point format.
-LasCloud ReadLas(const std::filesystem::path& path);
+LasCloud ReadLas(const std::filesystem::path& path, bool extra_values = false);
 
 // Writes `X Y Z` lines with `precision` decimals, or `X Y Z R G B` with 8-bit
 // colour (ColorTo8) when `rgb`, atomically.

@@ -43,9 +43,12 @@ struct PointCloud {
 };
 
 // Writes binary little-endian PLY, atomically: one `vertex` element with
-// double x y z, then float nx ny nz, uchar red green blue, float score and
-// views (uchar when every count is at most 255, else int), each group only
-// when its has_* flag is set. Line breaks in `crs` become spaces so that the
+// double x y z, then float nx ny nz, uchar red green blue, float scalar_score
+// and scalar_views (uchar when every count is at most 255, else int), each
+// group only
+// when its has_* flag is set. Score and views are named `scalar_*` because
+// CloudCompare, in command-line mode, keeps only properties so named (as
+// scalar fields) and drops the rest. Line breaks in `crs` become spaces so that the
 // comment stays one header line. Throws sapmvs::Error naming `path` and the
 // point at fault (a non-finite coordinate, a negative view count) before
 // anything is written.
@@ -54,8 +57,9 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud);
 // Reads ascii, binary_little_endian and binary_big_endian PLY 1.0. From the
 // `vertex` element: x y z (any scalar type, usually float or double), and when
 // declared nx ny nz, red green blue (uchar; ushort is scaled to 8 bit), score
-// and views (any scalar type). Other vertex properties, lists included, are
-// skipped by their declared type; elements before `vertex` are skipped, those
+// and views (any scalar type; named scalar_score and scalar_views, as written
+// since, or score and views, as written before and by PMVS-style tools). Other vertex properties,
+// lists included, are skipped by their declared type; elements before `vertex` are skipped, those
 // after it are not read. A `comment crs ...` line fills `crs`.
 // Throws sapmvs::InputError naming the file (and the header line, or the data
 // line of an ascii file) when the header is malformed, there is no vertex

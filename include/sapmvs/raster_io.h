@@ -40,6 +40,12 @@ struct GeoRaster {
 // cell size, unknown CRS) or the GDAL failure; no file is left behind.
 void WriteGeoTiff(const std::filesystem::path& path, const GeoRaster& raster);
 
+// Writes `rgba` (8 bit, 4 per pixel, row-major, row 0 north) as an RGB GeoTIFF
+// with an alpha band on `grid`'s size, geotransform and CRS (its values are
+// not used), atomically, as WriteGeoTiff does.
+void WriteColorGeoTiff(const std::filesystem::path& path, const GeoRaster& grid,
+                       const std::vector<uint8_t>& rgba);
+
 // Reads band 1 of any raster GDAL opens, as float. A south-up raster is
 // flipped to north-up; rotated or non-square cells are refused. Without a
 // nodata value in the file, `nodata` is NaN. Throws sapmvs::InputError naming
@@ -58,5 +64,9 @@ struct CrsIdentity {
 };
 // `crs` as CrsToWkt takes it, not empty. Throws sapmvs::Error naming the text.
 CrsIdentity IdentifyCrs(const std::string& crs);
+// The CRS's horizontal unit as an axis label: "m", "ft", "ftUS", "deg" for a
+// geographic CRS, another unit's name; "" without a CRS or for one that
+// cannot be read.
+std::string CrsLinearUnit(const std::string& crs);
 
 }  // namespace sapmvs

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "fuzz_util.h"
+#include "sapmvs/cloud_las.h"
 #include "sapmvs/export_frame.h"
 #include "sapmvs/las_io.h"
 #include "sapmvs/ply_io.h"
@@ -193,6 +194,11 @@ void CloudSeeds(const fs::path& out) {
   WriteLas(out / "las" / "plain.las", records, o);
   o.crs = "EPSG:32632";
   WriteLas(out / "las" / "crs.las", records, o);
+  // Extra Bytes, as cloud.las has them, in both versions.
+  cloud.has_normals = cloud.has_scores = cloud.has_views = true;
+  WriteLas(out / "las" / "extra_bytes_12.las", ToLasRecords(cloud), o, ToLasExtras(cloud));
+  o.version = LasVersion::k14;
+  WriteLas(out / "las" / "extra_bytes_14.las", ToLasRecords(cloud), o, ToLasExtras(cloud));
 }
 
 }  // namespace
