@@ -141,6 +141,8 @@ std::vector<BadInputCase> BadInputCases() {
       // the command line: refused before the block is read
       {"LevelNotAnInteger", "`run --level abc`", "not an integer", YamlAsIs,
        "run {D}/block.yaml --out {D}/out --level abc"},
+      {"LasVersionUnknown", "`run --las-version 1.3`", "a LAS version sapmvs does not write",
+       YamlAsIs, "run {D}/block.yaml --out {D}/out --las-version 1.3"},
       {"UnknownFlag", "`info --colour`", "no such flag", YamlAsIs, "info {D}/block.yaml --colour"},
       {"ThreadsNegative", "`--threads -1`", "a negative thread count", YamlAsIs,
        "--threads -1 info {D}/block.yaml"},
