@@ -484,6 +484,12 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     throw Error(reason);
   }
   const std::vector<Footprint> fp = Footprints(block, geometry);
+  // The strategy's plan first, even for a block that is then kept whole: its
+  // checks (tile cost, a block that does not look down) are the options'.
+  if (options.strategy == GroupingStrategy::kStrip)
+    PlanStrips(block, options, fp, &plan);
+  else
+    PlanFootprint(block, options, geometry, fp, &plan);
   ImageGroup all;
   all.images.resize(block.images.size());
   std::iota(all.images.begin(), all.images.end(), 0);
@@ -493,14 +499,11 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     for (const int i : all.images) all.center += fp[i].center;
     all.center /= static_cast<double>(all.images.size());
     all.short_of_views = ShortOfViews(fp, all.images, options.min_image_num);
-    plan.groups.push_back(all);
+    plan.groups.assign(1, all);
+    plan.ungrouped.clear();
     plan.single_group = true;
     return plan;
   }
-  if (options.strategy == GroupingStrategy::kStrip)
-    PlanStrips(block, options, fp, &plan);
-  else
-    PlanFootprint(block, options, geometry, fp, &plan);
   for (ImageGroup& g : plan.groups) {
     g.memory = EstimateGroupMemory(block, g.images, options.level);
     g.short_of_views = ShortOfViews(fp, g.images, options.min_image_num);

@@ -227,7 +227,7 @@ TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {
   EXPECT_EQ(dsm.crs, CrsToWkt("EPSG:32651"));
   EXPECT_EQ(ReadLas(out_ / "cloud.las").crs_wkt, CrsToWkt("EPSG:32651"));
   std::ifstream report(out_ / "report.json");
-  EXPECT_EQ(nlohmann::json::parse(report).value("crs", ""), "EPSG:32651");
+  EXPECT_EQ(nlohmann::json::parse(report).at("crs").at("epsg"), 32651);
 }
 
 TEST_F(CliRunTest, MinImageNumTwoIsAccepted) {
