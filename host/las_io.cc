@@ -535,7 +535,10 @@ LasCloud ReadLas(const std::filesystem::path& path, bool extra_values) {
     cloud.extras.push_back(f.field);
     if (extra_values) cloud.extras.back().values.resize(count);
   }
-  std::vector<uint8_t> buf(kChunkPoints * record_length);
+  // No larger than the points the file holds: a record length up to 65,535
+  // bytes (extra bytes) times a whole chunk was 4 GB for a 1 kB file (fuzzing).
+  std::vector<uint8_t> buf(static_cast<size_t>(std::min<uint64_t>(kChunkPoints, count)) *
+                           record_length);
   in.seekg(static_cast<std::streamoff>(point_offset));
   for (uint64_t first = 0; first < count; first += kChunkPoints) {
     const size_t n = static_cast<size_t>(std::min<uint64_t>(kChunkPoints, count - first));

@@ -281,6 +281,8 @@ class BinaryCursor {
 };
 
 uint8_t ToColor8(double v, PlyType type) {
+  // NaN passes std::clamp unchanged, and its cast is undefined (fuzzing).
+  if (std::isnan(v)) return 0;
   if (type == PlyType::kUint16) v = std::floor((v + 128) / 257);
   return static_cast<uint8_t>(std::clamp(std::round(v), 0.0, 255.0));
 }

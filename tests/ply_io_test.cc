@@ -377,6 +377,27 @@ TEST_F(PlyIoTest, BinaryViewsThatAreNoCountAreRefused) {
   }
 }
 
+// Found by fuzz_ply: a float colour of NaN passed std::clamp unchanged and
+// its cast to 8 bits was undefined (UBSan fails this in the sanitizer build).
+TEST_F(PlyIoTest, NanFloatColourReadsAsBlack) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+      "property float y\nproperty float z\nproperty float red\nproperty float green\n"
+      "property float blue\nend_header\n";
+  Bytes b(header.begin(), header.end());
+  const float v[6] = {1, 2, 3, std::numeric_limits<float>::quiet_NaN(), 300, 7.4f};
+  const uint8_t* raw = reinterpret_cast<const uint8_t*>(v);
+  b.insert(b.end(), raw, raw + sizeof v);
+  const fs::path path = dir_ / "nan_colour.ply";
+  WriteBytes(path, b);
+  const PointCloud c = ReadPly(path);
+  ASSERT_EQ(c.points.size(), 1u);
+  ASSERT_TRUE(c.has_colors);
+  EXPECT_EQ(c.points[0].color[0], 0);
+  EXPECT_EQ(c.points[0].color[1], 255);
+  EXPECT_EQ(c.points[0].color[2], 7);
+}
+
 TEST_F(PlyIoTest, FifoIsRefusedWithoutBlocking) {
   const fs::path path = dir_ / "fifo.ply";
   ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
