@@ -62,11 +62,6 @@ std::string Num(double v) {
   return s.str();
 }
 
-std::string FixedString(const uint8_t* p, size_t n) {
-  return std::string(reinterpret_cast<const char*>(p),
-                     strnlen(reinterpret_cast<const char*>(p), n));
-}
-
 }  // namespace
 
 size_t ExtraTypeSize(LasExtraType type) {
@@ -259,6 +254,12 @@ double DecodeExtraValue(const ExtraFieldLayout& layout, const uint8_t* extra) {
       break;
   }
   return v * layout.scale + layout.add;
+}
+
+std::string FixedString(const uint8_t* p, size_t n) {
+  if (n == 0) return {};  // an empty record's data() may be null
+  return std::string(reinterpret_cast<const char*>(p),
+                     strnlen(reinterpret_cast<const char*>(p), n));
 }
 
 }  // namespace sapmvs::las

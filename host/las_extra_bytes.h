@@ -52,4 +52,8 @@ std::vector<ExtraFieldLayout> DecodeExtraDescriptors(const std::vector<uint8_t>&
 // The value of `layout` in a record whose extra bytes start at `extra`.
 double DecodeExtraValue(const ExtraFieldLayout& layout, const uint8_t* extra);
 
+// A NUL-padded fixed-size text field of a LAS header or record (at most `n`
+// bytes); "" for n = 0, where `p` may be null.
+std::string FixedString(const uint8_t* p, size_t n);
+
 }  // namespace sapmvs::las

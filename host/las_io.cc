@@ -65,12 +65,6 @@ std::string Num(double v) {
   return s.str();
 }
 
-std::string FixedString(const uint8_t* p, size_t n) {
-  if (n == 0) return {};  // an empty record's data() may be null
-  return std::string(reinterpret_cast<const char*>(p),
-                     strnlen(reinterpret_cast<const char*>(p), n));
-}
-
 // 10^exponent as the double nearest the decimal (0.001, not 0.001 * 10 * 10),
 // so that headers show round scales.
 double DecimalScale(int exponent) {
@@ -285,7 +279,7 @@ void DecodePoint(const uint8_t* p, int format, const LasCloud& cloud, PointRecor
 }
 
 bool IsRecord(const uint8_t* record_header, const char* user_id, uint16_t record_id) {
-  return FixedString(record_header + 2, 16) == user_id &&
+  return las::FixedString(record_header + 2, 16) == user_id &&
          Get<uint16_t>(record_header + 18) == record_id;
 }
 bool IsWktRecord(const uint8_t* h) { return IsRecord(h, kProjectionUserId, kWktRecordId); }
@@ -305,7 +299,7 @@ std::vector<uint8_t> ReadAt(std::ifstream& in, uint64_t pos, size_t n, const std
 }
 
 std::string WktFromPayload(const std::vector<uint8_t>& payload) {
-  return FixedString(payload.data(), payload.size());
+  return las::FixedString(payload.data(), payload.size());
 }
 
 }  // namespace
