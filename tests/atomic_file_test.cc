@@ -28,10 +28,7 @@ class AtomicFileTest : public test::ScratchTest {
   }
 };
 
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using test::Slurp;
 
 void Spit(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 

@@ -85,15 +85,11 @@ TEST(CliGlobalFlags, BadThreadCountIsOneLineNamingIt) {
   ExpectOneLineError(RunCli("info /tmp/x --threads many"), {"--threads", "'many'"});
 }
 
+using test::Slurp;
+
 class CliLogTest : public test::ScratchTest {
  protected:
   static fs::path Block() { return test::Simulated("tiny", 1) / "block.yaml"; }
-  static std::string Slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
 };
 
 // Refused in one line before the subcommand does anything: no output, and

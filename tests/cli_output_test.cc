@@ -43,12 +43,7 @@ std::string FullDiskUnder(const fs::path& dir, long bytes) {
          " SAPMVS_FULL_DISK_BYTES=" + std::to_string(bytes);
 }
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::Slurp;
 
 void Spit(const fs::path& p, const std::string& text) {
   fs::create_directories(p.parent_path());

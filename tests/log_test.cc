@@ -16,12 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::Slurp;
 
 TEST(Iso8601Utc, MillisecondsAndZulu) {
   const std::chrono::system_clock::time_point t{std::chrono::milliseconds(1234)};

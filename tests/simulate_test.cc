@@ -33,12 +33,7 @@ SimulateOptions Tiny(const fs::path& out, double scale = 1.0, uint64_t seed = 1)
   return o;
 }
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::Slurp;
 
 // The files simulate wrote, without the folder's marker (output_folder.h),
 // which holds the writer's pid and so differs between runs.
