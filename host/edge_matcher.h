@@ -1,6 +1,6 @@
 #pragma once
 // Edge points matched along epipolar lines (the paper's addition to PMVS's
-// seeds, method.md 3.2). Each Canny edge pixel of an image is searched for
+// seeds, method.md 3.7). Each Canny edge pixel of an image is searched for
 // along its epipolar segment in the image's best view, within the depth range
 // its seeds span: the edge pixels of the view on the segment are triangulated
 // and scored (window_size NCC, fronto-parallel to the reference, on the

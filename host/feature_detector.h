@@ -1,5 +1,5 @@
 #pragma once
-// Seed features (method.md 3.2): Harris corners and difference-of-Gaussian
+// Seed features (method.md 3.4, 3.7): Harris corners and difference-of-Gaussian
 // blobs, at most a few of each per 32 x 32 block so that seeds cover the whole
 // image; and edge pixels (Canny) for the propagation barriers.
 #include <Eigen/Core>

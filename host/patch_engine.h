@@ -1,6 +1,6 @@
 #pragma once
 // Evaluates batches of candidate patches on the device, the same way for
-// seeds and for every propagation wave (method.md 3.3, 4): pick the views a
+// seeds and for every propagation wave (method.md 3.5, 3.6, 4.1): pick the views a
 // candidate is visible in, keep those whose NCC reaches threshold_before,
 // refine depth and normal in-kernel, keep the views whose NCC then reaches
 // threshold, and accept the patch when they are at least min_image_num - 1.

@@ -1,5 +1,5 @@
 #pragma once
-// Filtering of the matched points (method.md 3.5). Points of patches that
+// Filtering of the matched points (method.md 3.9). Points of patches that
 // score below the caller's score floor go first; then three passes:
 //  1. visibility: per image, a depth buffer on the cell grid from every
 //     point's reference and photo-consistent views. A point is occluded in an

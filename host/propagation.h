@@ -1,5 +1,5 @@
 #pragma once
-// The patch queue and the cell grids (method.md 3.4, 4). Accepted patches
+// The patch queue and the cell grids (method.md 3.8, 4.1). Accepted patches
 // emit points into empty cells of their reference image and mark the cells
 // their points fall in in every photo-consistent view; their neighbourhood
 // becomes the next wave's candidates:

@@ -1,5 +1,5 @@
 #pragma once
-// Seed candidates (method.md 3.2): for each feature of each image, features
+// Seed candidates (method.md 3.4): for each feature of each image, features
 // of the same kind within `epipolar_distance` pixels of its epipolar line in
 // the image's views are triangulated, and the resulting points are ordered by
 // depth consistency: how many further views hold a same-kind feature within

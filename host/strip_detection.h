@@ -1,6 +1,6 @@
 #pragma once
 // Flight strips of an aerial block, found from the camera centres and
-// headings alone (method.md 2), so that grouping needs no image and no flight
+// headings alone (method.md 2.1), so that grouping needs no image and no flight
 // log, and so that the result does not depend on the order the block lists
 // its images in:
 //  1. Headings: the camera's image x axis on the ground (kappa, for a frame

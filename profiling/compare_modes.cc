@@ -1,4 +1,4 @@
-// SAPMVS against PMVS on one block, in one run (method.md 3.4; the paper's
+// SAPMVS against PMVS on one block, in one run (method.md 3.6, 3.10; the paper's
 // Tables 4 and 6): wall time, points, accuracy and coverage against the true
 // surface, and the ratios. Both modes share one OpenCL context, so kernels
 // are compiled before the first timing starts.

@@ -1,6 +1,6 @@
 #pragma once
 // Merging the clouds of overlapping image groups into one cloud that holds
-// each surface point once (method.md 2; the paper keeps the union and does
+// each surface point once (method.md 5.1; the paper keeps the union and does
 // not say how duplicates go).
 //
 // Each group owns a core: the XY points nearer to its ground centre than to

@@ -1,6 +1,6 @@
 #pragma once
 // `sapmvs evaluate`: the height accuracy of a dense cloud against airborne
-// LiDAR or a DSM raster, with the paper's protocol (docs: method.md section 5;
+// LiDAR or a DSM raster, with the paper's protocol (docs: method.md section 6.1;
 // the paper's Tables 9-11).
 //
 // Against LiDAR, a cloud point's reference height is the mean Z of the LiDAR
