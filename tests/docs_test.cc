@@ -1,7 +1,8 @@
-// The code's comments cite sections of docs/method.md by number ("method.md
-// 3.6", "method.md section 6.1", "method.md 3 and 4"); a citation of a
-// section the page does not have points a reader nowhere. The needle is
-// spelt in pieces below so that this file does not cite anything itself.
+// The code's comments cite sections of docs/method.md by number: the page's
+// name followed by "3.6", "section 6.1", "3.5, 3.6, 4.1" or "3 and 4". A
+// citation of a section the page does not have points a reader nowhere. The
+// needle is spelt in pieces below, so that the test's own strings are not
+// taken for citations.
 #include <gtest/gtest.h>
 
 #include <algorithm>
