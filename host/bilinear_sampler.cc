@@ -32,28 +32,6 @@ void CheckBufferHolds(const ClBuffer& buffer, const char* what, size_t bytes) {
 
 }  // namespace
 
-size_t ImageLayout::RequiredElements() const {
-  if (width <= 0 || height <= 0) return 0;
-  return static_cast<size_t>(height - 1) * static_cast<size_t>(row_pitch) +
-         static_cast<size_t>(width);
-}
-
-void ImageLayout::Validate(const char* what) const {
-  const std::string size = std::to_string(width) + "x" + std::to_string(height);
-  if (width <= 0 || height <= 0) {
-    throw Error(std::string(what) + " is empty (" + size + "); expected at least 1x1 pixels");
-  }
-  if (width > kMaxImageSide || height > kMaxImageSide) {
-    throw Error(std::string(what) + " of " + size +
-                " pixels exceeds the float32 kernels' limit of " + std::to_string(kMaxImageSide) +
-                " pixels per side");
-  }
-  if (row_pitch < width) {
-    throw Error(std::string(what) + " row pitch " + std::to_string(row_pitch) +
-                " is smaller than its width " + std::to_string(width));
-  }
-}
-
 bool BilinearSamplerOptions::Check() const { return work_group_size >= 1; }
 
 BilinearSampler::BilinearSampler(ClContext& context, const BilinearSamplerOptions& options)
@@ -102,36 +80,6 @@ ClEvent BilinearSampler::Sample(const ClBuffer& image, const ImageLayout& layout
                   cl_int{layout.row_pitch}, values);
   const size_t group = static_cast<size_t>(options_.work_group_size);
   return context_.Enqueue(kernel_, NDRange(static_cast<size_t>(num_points)), NDRange(group));
-}
-
-double BilinearSampleReference(const FloatImageView& image, double x, double y) {
-  const ImageLayout& layout = image.layout;
-  layout.Validate("bilinear reference image");
-  if (image.data == nullptr) throw Error("bilinear reference image has no pixel data");
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (!(x >= 0.0 && y >= 0.0 && x <= layout.width - 1 && y <= layout.height - 1)) return nan;
-  // Same cell clamping as the kernel; see kernels/bilinear_sample.cl.
-  const int x0 = std::min(static_cast<int>(x), std::max(layout.width - 2, 0));
-  const int y0 = std::min(static_cast<int>(y), std::max(layout.height - 2, 0));
-  const int x1 = std::min(x0 + 1, layout.width - 1);
-  const int y1 = std::min(y0 + 1, layout.height - 1);
-  const double fx = x - x0;
-  const double fy = y - y0;
-  const float* row0 = image.data + static_cast<size_t>(y0) * static_cast<size_t>(layout.row_pitch);
-  const float* row1 = image.data + static_cast<size_t>(y1) * static_cast<size_t>(layout.row_pitch);
-  const double top = (1.0 - fx) * row0[x0] + fx * row0[x1];
-  const double bottom = (1.0 - fx) * row1[x0] + fx * row1[x1];
-  return (1.0 - fy) * top + fy * bottom;
-}
-
-std::vector<double> BilinearSampleReference(const FloatImageView& image,
-                                            const std::vector<Eigen::Vector2f>& points) {
-  image.layout.Validate("bilinear reference image");
-  std::vector<double> values;
-  values.reserve(points.size());
-  for (const Eigen::Vector2f& p : points)
-    values.push_back(BilinearSampleReference(image, p.x(), p.y()));
-  return values;
 }
 
 }  // namespace sapmvs

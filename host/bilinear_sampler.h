@@ -1,6 +1,7 @@
 #pragma once
 // Bilinear sampling of a single-channel float image at a batch of sub-pixel
-// positions (kernels/bilinear_sample.cl), plus its double-precision reference.
+// positions (kernels/bilinear_sample.cl); its double-precision reference is in
+// float_image.h.
 // Pixel (0, 0) is the centre of the top-left pixel; a position is valid iff
 // 0 <= x <= width - 1 and 0 <= y <= height - 1, and gives NaN otherwise (see
 // the kernel file for the full policy, which both implementations share).
@@ -11,27 +12,10 @@
 #include <vector>
 
 #include "cl_runtime.h"
+#include "float_image.h"
 #include "sapmvs/kernel_limits.h"
 
 namespace sapmvs {
-
-// Shape of a row-major single-channel float image.
-struct ImageLayout {
-  int width = 0;      // Pixels, 1 to kMaxImageSide.
-  int height = 0;     // Pixels, 1 to kMaxImageSide.
-  int row_pitch = 0;  // Elements from one row start to the next, >= width.
-
-  // Elements a buffer must hold: (height - 1) * row_pitch + width.
-  size_t RequiredElements() const;
-  // Throws Error naming `what` unless the layout is usable.
-  void Validate(const char* what) const;
-};
-
-// A host image, not owned.
-struct FloatImageView {
-  const float* data = nullptr;
-  ImageLayout layout;
-};
 
 struct BilinearSamplerOptions {
   // Work-items per work-group, passed to the kernel as -D WORK_GROUP_SIZE.
@@ -66,11 +50,5 @@ class BilinearSampler {
   BilinearSamplerOptions options_;
   ClKernel kernel_;
 };
-
-// The kernel's twin in double precision, with exactly the same border and NaN
-// policy. Throws Error for an invalid image.
-double BilinearSampleReference(const FloatImageView& image, double x, double y);
-std::vector<double> BilinearSampleReference(const FloatImageView& image,
-                                            const std::vector<Eigen::Vector2f>& points);
 
 }  // namespace sapmvs

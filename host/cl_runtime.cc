@@ -208,11 +208,7 @@ bool DeviceOptions::Check() const {
 }
 
 DeviceSpec EffectiveDeviceSpec(const DeviceOptions& options) {
-  if (std::string spec = Trim(options.device); !spec.empty()) return {spec, "--device"};
-  if (const char* env = std::getenv("SAPMVS_DEVICE")) {
-    if (std::string spec = Trim(env); !spec.empty()) return {spec, "SAPMVS_DEVICE"};
-  }
-  return {};
+  return DeviceSpecFor(options.device);
 }
 
 int DefaultDeviceIndex(const std::vector<DeviceInfo>& devices) {

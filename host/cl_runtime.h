@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "cl_error.h"
+#include "device_spec.h"
 
 namespace sapmvs {
 
@@ -90,11 +91,7 @@ struct DeviceOptions {
   bool Check() const;
 };
 
-// The device spec in effect and where it came from.
-struct DeviceSpec {
-  std::string value;   // Trimmed; "" = use the default.
-  std::string source;  // "--device", "SAPMVS_DEVICE" or "" for the default.
-};
+// The device spec in effect and where it came from (device_spec.h).
 DeviceSpec EffectiveDeviceSpec(const DeviceOptions& options);
 
 // Index into `devices` of the default device (see DeviceOptions::device).

@@ -57,7 +57,8 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   cmd->add_option("--mode", *mode, "sapmvs (self-adaptive patch) or pmvs")->capture_default_str();
   cmd->option_defaults()->group("Device");
   cmd->add_option("--device", o->device,
-                  "OpenCL device: index or name substring (see `sapmvs devices`)");
+                  "OpenCL device: index or name substring (see `sapmvs devices`), or "
+                  "`reference` for the CPU reference (no OpenCL)");
   cmd->option_defaults()->group("Matching");
   cmd->add_option("--level", m.level, "Pyramid level: 0 full resolution, 1 half, ...")
       ->capture_default_str();

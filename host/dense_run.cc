@@ -12,7 +12,7 @@
 #include <numeric>
 #include <sstream>
 
-#include "cl_runtime.h"
+#include "patch_kernels.h"
 #include "run_checkpoint.h"
 #include "run_progress.h"
 #include "run_report.h"
@@ -162,15 +162,13 @@ RunReport RunDense(const RunOptions& options) {
   for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   end_stage("plan");
 
-  DeviceOptions device_options;
-  device_options.device = options.device;
-  device_options.profile = options.profile;
-  ClContext context(device_options);
-  report.device = context.device().Describe();
-  report.device_info = {
-      context.device().name, context.device().vendor,
-      context.device().platform_name + " (" + context.device().platform_version + ")",
-      DeviceTypeName(context.device().type)};
+  PatchKernelsOptions kernel_options;
+  kernel_options.device = options.device;
+  kernel_options.profile = options.profile;
+  const std::unique_ptr<PatchKernels> kernels = MakePatchKernels(kernel_options);
+  const KernelDevice& device = kernels->device();
+  report.device = device.description;
+  report.device_info = {device.name, device.vendor, device.platform, device.type};
   LogDetail("device: " + report.device);
 
   const OutputFolder folder(options.out, "run", {"groups"});
@@ -211,7 +209,7 @@ RunReport RunDense(const RunOptions& options) {
     progress.StartGroup(g, n, static_cast<long>(plan.groups[g].images.size()));
     const auto t0 = std::chrono::steady_clock::now();
     MatchResult result =
-        MatchGroup(block, plan.groups[g].images, options.matcher, context, &geometry,
+        MatchGroup(block, plan.groups[g].images, options.matcher, *kernels, &geometry,
                    [&](const MatchProgressEvent& e) { progress.Update(e); });
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());

@@ -12,10 +12,6 @@
 #include <sstream>
 #include <tuple>
 
-#include "ncc_scorer.h"
-#include "patch_engine.h"
-#include "patch_refiner.h"
-#include "propagation.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/error.h"
 #include "sapmvs/kernel_limits.h"
@@ -440,10 +436,8 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
   if (matcher.level < 0 || matcher.level > kMaxLevel)
     throw Error("memory estimate: level in 0.." + std::to_string(kMaxLevel) + " expected, got " +
                 std::to_string(matcher.level));
-  const double views = kMaxViews - 1;
+  const MatcherMemoryModel model = MatcherMemory();
   const double cs = std::max(1, matcher.cell_size);
-  const double per_cell =
-      4 + 1 + 3 * sizeof(float) + sizeof(AcceptedPatch) + 4 * views + sizeof(DensePoint);
   GroupMemory m;
   double load = 0;
   for (const int id : images) {
@@ -453,15 +447,13 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
     const Intrinsics k = cam.intrinsics().Scaled(std::ldexp(1.0, -matcher.level));
     const double pixels = static_cast<double>(k.width) * k.height;
     const double cells = std::ceil(k.width / cs) * std::ceil(k.height / cs);
-    m.device_bytes += 8 * pixels;
-    m.host_bytes += 20 * pixels + per_cell * cells;
+    m.device_bytes += model.device_bytes_per_pixel * pixels;
+    m.host_bytes += model.host_bytes_per_pixel * pixels + model.host_bytes_per_cell * cells;
     load = std::max(load, 6.0 * cam.width() * cam.height());
   }
   const double wave = std::max(0, matcher.max_wave);
-  m.device_bytes +=
-      wave * (sizeof(NccPatch) + sizeof(RefinedPatchOut) + 4 + views * (sizeof(NccPair) + 4 + 4));
-  m.host_bytes +=
-      wave * (sizeof(PatchCandidate) + sizeof(std::optional<AcceptedPatch>) + 4 * views);
+  m.device_bytes += wave * model.device_bytes_per_candidate;
+  m.host_bytes += wave * model.host_bytes_per_candidate;
   m.host_bytes += load;
   return m;
 }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "ncc_scorer.h"
+#include "patch_kernel_types.h"
 #include "sapmvs/block.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/camera.h"
@@ -30,7 +30,7 @@ struct MatchGroupData {
   std::vector<MatchImage> images;
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   double gsd = 0;  // median footprint of a working pixel at the expected depth
-  NccGroup ncc;    // views of `images` for the device (valid while images live)
+  NccGroup ncc;    // views of `images` for the patch kernels (valid while images live)
 };
 
 // Loads (undistorted) images `ids` of `block` and reduces them to `level`

@@ -8,7 +8,6 @@
 #include <optional>
 #include <sstream>
 
-#include "cl_runtime.h"
 #include "edge_matcher.h"
 #include "feature_detector.h"
 #include "match_group.h"
@@ -115,8 +114,23 @@ bool MatcherOptions::Check() const {
   return problem.empty();
 }
 
+MatcherMemoryModel MatcherMemory() {
+  const double views = kMaxViews - 1;
+  const KernelBatchBytes batch = PatchKernelBatchBytes();
+  MatcherMemoryModel m;
+  // grouping.h EstimateGroupMemory spells out each term.
+  m.device_bytes_per_pixel = 8;
+  m.host_bytes_per_pixel = 20;
+  m.host_bytes_per_cell =
+      4 + 1 + 3 * sizeof(float) + sizeof(AcceptedPatch) + 4 * views + sizeof(DensePoint);
+  m.device_bytes_per_candidate = batch.per_patch + views * batch.per_pair;
+  m.host_bytes_per_candidate =
+      sizeof(PatchCandidate) + sizeof(std::optional<AcceptedPatch>) + 4 * views;
+  return m;
+}
+
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
-                       const MatcherOptions& options, ClContext& context,
+                       const MatcherOptions& options, PatchKernels& kernels,
                        const BlockGeometry* geometry, const MatchProgressFn& on_progress) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("matcher options: expected " + problem);
@@ -183,7 +197,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   report("seeds", 0, 0, "epipolar candidates");
   const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
   report("seeds", 0, 0, "building kernels");
-  PatchEngine engine(context, group, options);
+  PatchEngine engine(kernels, group, options);
   engine_ptr = &engine;
   Propagator propagator(group, options, engine);
   propagator.RunSeeds(seeds, [&](long rank, long ranks, long accepted) {

@@ -31,28 +31,12 @@ double PatchEngine::SigmaColor() const {
   return options_.ncc_sigma_color;
 }
 
-PatchEngine::PatchEngine(ClContext& context, const MatchGroupData& group,
+PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
                          const MatcherOptions& options)
-    : context_(context), group_(group), options_(options) {
-  device_group_ = std::make_shared<const NccDeviceGroup>(UploadNccGroup(context_, group_.ncc));
-  std::vector<int> sizes = {options_.window_size};
-  if (options_.mode == MatchMode::kSapmvs) {
-    sizes.insert(sizes.end(), options_.adaptive_sizes.begin(), options_.adaptive_sizes.end());
-  }
-  for (const int size : sizes) {
-    if (scorers_.count(size)) continue;
-    NccScorerOptions so;
-    so.patch_size = size;
-    so.sigma_color = SigmaColor();
-    auto scorer = std::make_unique<NccScorer>(context_, so);
-    scorer->UseGroup(device_group_);
-    scorers_[size] = std::move(scorer);
-  }
-  PatchRefinerOptions ro;
-  ro.patch_size = options_.window_size;
-  ro.sigma_color = SigmaColor();
-  refiner_ = std::make_unique<PatchRefiner>(context_, ro);
-  refiner_->UseGroup(device_group_, group_.ncc.cameras);
+    : kernels_(kernels), group_(group), options_(options) {
+  kernels_.SetGroup(group_.ncc);
+  refine_options_.patch_size = options_.window_size;
+  refine_options_.sigma_color = SigmaColor();
   if (options_.mode == MatchMode::kSapmvs) {
     for (const int size : options_.adaptive_sizes) {
       if (size <= options_.window_size) continue;
@@ -62,41 +46,39 @@ PatchEngine::PatchEngine(ClContext& context, const MatchGroupData& group,
       po.depth_step = kPolishDepthStep;
       po.angle_step_deg = kPolishAngleStepDeg;
       po.sigma_color = SigmaColor();
-      auto polisher = std::make_unique<PatchRefiner>(context_, po);
-      polisher->UseGroup(device_group_, group_.ncc.cameras);
-      polishers_[size] = std::move(polisher);
+      polish_options_[size] = po;
     }
   }
 }
 
-std::vector<RefinedPatch> PatchEngine::RefineWith(PatchRefiner& refiner,
+PatchEngine::~PatchEngine() { kernels_.ClearGroup(); }
+
+std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
                                                   const std::vector<NccPatch>& patches,
                                                   const std::vector<std::vector<int>>& views) {
   if (patches.empty()) return {};
-  ClEvent event;
-  std::vector<RefinedPatch> out = refiner.Refine(patches, views, &event);
-  const int size = refiner.options().patch_size;
+  double seconds = 0;
+  std::vector<RefinedPatch> out = kernels_.Refine(ro, patches, views, &seconds);
+  const int size = ro.patch_size;
   // Rounds run: each either moved or halved, up to the halving limit.
-  const PatchRefinerOptions& ro = refiner.options();
   double evaluations = 0;
   for (size_t i = 0; i < views.size(); ++i) {
     const int rounds = std::min(ro.iterations, out[i].moves + ro.max_halvings);
     evaluations += static_cast<double>(views[i].size()) * (1 + 6 * rounds);
   }
   Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size), size,
-        static_cast<long>(patches.size()), evaluations, event);
+        static_cast<long>(patches.size()), evaluations, seconds);
   return out;
 }
 
 void PatchEngine::Count(const std::string& kernel, int patch_size, long items,
-                        double ncc_evaluations, const ClEvent& event) {
+                        double ncc_evaluations, double seconds) {
   KernelTime& t = kernel_times_[kernel];
   ++t.launches;
   t.items += items;
   t.ncc_evaluations += ncc_evaluations;
   t.patch_size = patch_size;
-  if (event.profiling()) {
-    const double seconds = 1e-9 * static_cast<double>(event.DeviceTimeNs());
+  if (seconds > 0) {
     t.seconds += seconds;
     t.max_seconds = std::max(t.max_seconds, seconds);
   }
@@ -105,10 +87,13 @@ void PatchEngine::Count(const std::string& kernel, int patch_size, long items,
 std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& patches,
                                         const std::vector<NccPair>& pairs) {
   if (pairs.empty()) return {};
-  ClEvent event;
-  std::vector<float> scores = scorers_.at(size)->Score(patches, pairs, &event);
+  NccScorerOptions so;
+  so.patch_size = size;
+  so.sigma_color = SigmaColor();
+  double seconds = 0;
+  std::vector<float> scores = kernels_.Score(so, patches, pairs, &seconds);
   Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size), size,
-        static_cast<long>(pairs.size()), static_cast<double>(pairs.size()), event);
+        static_cast<long>(pairs.size()), static_cast<double>(pairs.size()), seconds);
   return scores;
 }
 
@@ -321,7 +306,7 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
     refine_views.push_back(std::move(kept));
     refine_of.push_back(patch_of[k]);
   }
-  const std::vector<RefinedPatch> refined = RefineWith(*refiner_, to_refine, refine_views);
+  const std::vector<RefinedPatch> refined = RefineWith(refine_options_, to_refine, refine_views);
 
   // 3. Accept on the views that pass threshold after optimisation.
   std::vector<int> accepted_index;
@@ -363,7 +348,7 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
     for (const int i : open) {
       p.push_back(MakeNccPatch(results[i]->center, results[i]->normal, results[i]->ref));
     }
-    const std::vector<RefinedPatch> polished = RefineWith(*polishers_.at(size), p, q);
+    const std::vector<RefinedPatch> polished = RefineWith(polish_options_.at(size), p, q);
     // Patches that pass at this size, before the corner test.
     struct Pass {
       size_t k;

@@ -23,14 +23,12 @@
 // LiDAR from 54.5 % to 70.8 %).
 #include <Eigen/Core>
 #include <map>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "match_group.h"
-#include "ncc_scorer.h"
-#include "patch_refiner.h"
+#include "patch_kernels.h"
 #include "sapmvs/matcher.h"
 
 namespace sapmvs {
@@ -59,7 +57,12 @@ struct AcceptedPatch {
 
 class PatchEngine {
  public:
-  PatchEngine(ClContext& context, const MatchGroupData& group, const MatcherOptions& options);
+  // Hands `group` to `kernels` (PatchKernels::SetGroup) until the engine is
+  // destroyed; both must outlive the engine.
+  PatchEngine(PatchKernels& kernels, const MatchGroupData& group, const MatcherOptions& options);
+  ~PatchEngine();
+  PatchEngine(const PatchEngine&) = delete;
+  PatchEngine& operator=(const PatchEngine&) = delete;
 
   // One result per candidate, in order; nullopt = rejected.
   std::vector<std::optional<AcceptedPatch>> Evaluate(const std::vector<PatchCandidate>& candidates);
@@ -69,7 +72,7 @@ class PatchEngine {
   std::vector<float> Score(const std::vector<NccPatch>& patches, const std::vector<NccPair>& pairs);
 
   // Kernel launches, items and device seconds so far (seconds are 0 without
-  // a profiling queue).
+  // profiling).
   const std::map<std::string, KernelTime>& kernel_times() const { return kernel_times_; }
 
  private:
@@ -101,17 +104,16 @@ class PatchEngine {
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,
                              const std::vector<NccPair>& pairs);
   void Count(const std::string& kernel, int patch_size, long items, double ncc_evaluations,
-             const ClEvent& event);
-  std::vector<RefinedPatch> RefineWith(PatchRefiner& refiner, const std::vector<NccPatch>& patches,
+             double seconds);
+  std::vector<RefinedPatch> RefineWith(const PatchRefinerOptions& options,
+                                       const std::vector<NccPatch>& patches,
                                        const std::vector<std::vector<int>>& views);
 
-  ClContext& context_;
+  PatchKernels& kernels_;
   const MatchGroupData& group_;
   const MatcherOptions& options_;
-  std::shared_ptr<const NccDeviceGroup> device_group_;
-  std::map<int, std::unique_ptr<NccScorer>> scorers_;  // by patch side
-  std::unique_ptr<PatchRefiner> refiner_;
-  std::map<int, std::unique_ptr<PatchRefiner>> polishers_;  // by patch side (sapmvs)
+  PatchRefinerOptions refine_options_;
+  std::map<int, PatchRefinerOptions> polish_options_;  // by patch side (sapmvs)
   std::map<std::string, KernelTime> kernel_times_;
 };
 

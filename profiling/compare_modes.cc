@@ -12,7 +12,7 @@
 #include <iomanip>
 #include <iostream>
 
-#include "cl_runtime.h"
+#include "patch_kernels.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
 #include "sapmvs/error.h"
@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   app.add_option("block", block_path, "Block file or folder")->required();
   app.add_option("--truth", truth_path, "True surface raster (truth/dsm.tif)")->required();
   app.add_option("--level", level, "Pyramid level")->capture_default_str();
-  app.add_option("--device", device, "OpenCL device");
+  app.add_option("--device", device, "OpenCL device, or reference (the CPU reference)");
   app.add_option("--csv", csv_path, "Write the rows as CSV");
   double coverage_cells = 1;
   app.add_option("--coverage-cells", coverage_cells,
@@ -79,10 +79,10 @@ int main(int argc, char** argv) {
     const SurfaceCheckOptions so =
         TruthCheckOptions(truth_data, gsd, level, coverage_cells * base.cell_size);
     const double coverage_cell = so.cell_size;
-    DeviceOptions dev;
+    PatchKernelsOptions dev;
     dev.device = device;
     dev.profile = true;
-    ClContext context(dev);
+    const std::unique_ptr<PatchKernels> kernels = MakePatchKernels(dev);
     std::vector<Row> rows;
     std::vector<MatchMode> modes = {MatchMode::kPmvs, MatchMode::kSapmvs};
     if (!only.empty()) modes = {ParseMatchMode(only)};
@@ -95,9 +95,9 @@ int main(int argc, char** argv) {
       MatcherOptions warm = o;
       warm.max_waves = 1;
       warm.use_edges = false;
-      (void)MatchGroup(block, {}, warm, context);
+      (void)MatchGroup(block, {}, warm, *kernels);
       const auto start = std::chrono::steady_clock::now();
-      const MatchResult r = MatchGroup(block, {}, o, context);
+      const MatchResult r = MatchGroup(block, {}, o, *kernels);
       Row row;
       row.mode = ToString(mode);
       row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -53,5 +53,19 @@ TEST(CliDevices, NoPlatformSaysHowToInstallPoclAndExits2) {
   EXPECT_NE(r.err.find("pocl-opencl-icd"), std::string::npos) << r.err;
 }
 
+// The CPU reference needs no OpenCL platform: without one `devices` still
+// says what --device reference (or SAPMVS_DEVICE=reference) picks.
+TEST(CliDevices, ReferenceNeedsNoPlatform) {
+  const std::filesystem::path empty = test::ScratchDir();
+  for (const std::string& how :
+       {std::string("devices --device reference"), std::string("devices")}) {
+    const std::string env =
+        "OCL_ICD_VENDORS=" + empty.string() + (how == "devices" ? " SAPMVS_DEVICE=Reference" : "");
+    const auto r = RunCli(how, env);
+    EXPECT_EQ(r.exit_code, 0) << how << ": " << r.err;
+    EXPECT_NE(r.out.find("the CPU reference backend"), std::string::npos) << how << ": " << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace sapmvs

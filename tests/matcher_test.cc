@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cl_patch_kernels.h"
 #include "cl_test_fixture.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
@@ -160,7 +161,8 @@ class MatchGroupTest : public test::ClTest {
   Measured MatchAndCheck(const MatcherOptions& options) {
     Measured m;
     const Block block = ReadBlock(TinyDir() / "block.yaml");
-    m.result = MatchGroup(block, {}, options, context());
+    const auto kernels = MakeClPatchKernels(context());
+    m.result = MatchGroup(block, {}, options, *kernels);
     const GeoRaster dsm = ReadGeoRaster(TinyDir() / "truth" / "dsm.tif");
     m.gsd = EstimateBlockGeometry(block).gsd_median;
     SurfaceCheckOptions so;
@@ -318,7 +320,8 @@ TEST_F(MatchRealBlockTest, NgiCloudFollowsTheDemWithoutGrossErrors) {
   MatcherOptions o;
   o.level = 0;
   o.progress = false;
-  const MatchResult r = MatchGroup(block, {}, o, context());
+  const auto kernels = MakeClPatchKernels(context());
+  const MatchResult r = MatchGroup(block, {}, o, *kernels);
   const GeoRaster dem = ReadGeoRaster(dem_path);
   const double gsd = EstimateBlockGeometry(block).gsd_median;  // about 6 m
   std::vector<double> abs_dz;

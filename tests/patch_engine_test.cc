@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
+#include "cl_patch_kernels.h"
 #include "cl_test_fixture.h"
 #include "match_group.h"
 #include "plane_scene.h"
@@ -58,7 +60,18 @@ std::vector<PatchCandidate> TiltedSeeds(const PlaneScene& scene, int count, doub
   return seeds;
 }
 
-class PatchEngineTest : public ClTest {};
+class PatchEngineTest : public ClTest {
+ protected:
+  // A backend per engine: an engine holds its group on its backend until it
+  // is destroyed, and some tests keep two engines.
+  PatchKernels& NewKernels() {
+    kernels_.push_back(MakeClPatchKernels(context()));
+    return *kernels_.back();
+  }
+
+ private:
+  std::vector<std::unique_ptr<PatchKernels>> kernels_;
+};
 
 // On flat textured ground every seed grows to the largest adaptive size,
 // from a 7 x 7 start whose normal is a few degrees off: the unpolished plane
@@ -73,7 +86,7 @@ TEST_F(PatchEngineTest, FlatGroundGrowsToTheLargestSizeFromATiltedStart) {
   // The scene's cameras are a few metres apart at 40 m: growth needs a view
   // 2 max_angle from the reference (WorthPolishing), so 5 degrees here.
   options.max_angle_deg = 5.0;
-  PatchEngine engine(context(), group, options);
+  PatchEngine engine(NewKernels(), group, options);
   const std::vector<PatchCandidate> seeds = TiltedSeeds(scene, 12, 1.0, 6.0, 92);
   const auto results = engine.Evaluate(seeds);
   ASSERT_EQ(results.size(), seeds.size());
@@ -100,7 +113,7 @@ TEST_F(PatchEngineTest, FlatGroundGrowsToTheLargestSizeFromATiltedStart) {
   EXPECT_EQ(largest, static_cast<int>(seeds.size()));
   // The same seeds in pmvs mode stay 7 x 7 (no adaptive sizes).
   options.mode = MatchMode::kPmvs;
-  PatchEngine pmvs(context(), group, options);
+  PatchEngine pmvs(NewKernels(), group, options);
   for (const auto& r : pmvs.Evaluate(seeds)) {
     ASSERT_TRUE(r);
     EXPECT_EQ(r->size, options.window_size);
@@ -115,14 +128,14 @@ TEST_F(PatchEngineTest, RejectsSeedsWithTooFewViewsOrFacingAway) {
   const MatchGroupData group = GroupOf(scene);
   MatcherOptions options;
   {
-    PatchEngine engine(context(), group, options);
+    PatchEngine engine(NewKernels(), group, options);
     const std::vector<PatchCandidate> away = TiltedSeeds(scene, 4, 0.0, 80.0, 95);
     for (const auto& r : engine.Evaluate(away)) EXPECT_FALSE(r);
     const std::vector<PatchCandidate> good = TiltedSeeds(scene, 4, 0.0, 0.0, 94);
     for (const auto& r : engine.Evaluate(good)) EXPECT_TRUE(r);
   }
   options.min_image_num = 5;
-  PatchEngine engine(context(), group, options);
+  PatchEngine engine(NewKernels(), group, options);
   for (const auto& r : engine.Evaluate(TiltedSeeds(scene, 4, 0.0, 0.0, 94))) EXPECT_FALSE(r);
 }
 
@@ -144,7 +157,7 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
   SelectViews(options, &group);
   EXPECT_EQ(group.images[0].views.size(), 4u);  // none dropped for being narrow
   {
-    PatchEngine engine(context(), group, options);
+    PatchEngine engine(NewKernels(), group, options);
     int accepted = 0;
     for (const auto& r : engine.Evaluate(TiltedSeeds(strip, 8, 0.5, 3.0, 97))) {
       if (!r) continue;
@@ -161,7 +174,7 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
   for (const double max_angle : {10.0, 3.0}) {
     MatcherOptions sapmvs;
     sapmvs.max_angle_deg = max_angle;
-    PatchEngine engine(context(), group, sapmvs);
+    PatchEngine engine(NewKernels(), group, sapmvs);
     int grown = 0, accepted = 0;
     for (const auto& r : engine.Evaluate(TiltedSeeds(strip, 8, 0.0, 0.0, 98))) {
       accepted += r.has_value();
@@ -177,11 +190,11 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
   }
   const PlaneScene narrow = MakePlaneScene(5, 201, 161, 96, 40.0 * std::tan(0.5 * kPiRad / 180.0));
   const MatchGroupData narrow_group = GroupOf(narrow);
-  PatchEngine engine(context(), narrow_group, options);
+  PatchEngine engine(NewKernels(), narrow_group, options);
   for (const auto& r : engine.Evaluate(TiltedSeeds(narrow, 8, 0.0, 0.0, 97))) EXPECT_FALSE(r);
   // The same seeds pass once max_angle allows the pairs' 1 to 2 degrees.
   options.max_angle_deg = 0.8;
-  PatchEngine lenient(context(), narrow_group, options);
+  PatchEngine lenient(NewKernels(), narrow_group, options);
   int accepted = 0;
   for (const auto& r : lenient.Evaluate(TiltedSeeds(narrow, 8, 0.0, 0.0, 97)))
     accepted += r.has_value();

@@ -36,7 +36,8 @@ struct RunOptions {
   // How to read it (format, image folder, size check, ground height).
   BlockReadOptions read;
   std::filesystem::path out;  // output folder, created when missing
-  // OpenCL device: index or name substring ("" = SAPMVS_DEVICE, else the default).
+  // OpenCL device: index or name substring, or "reference" for the CPU
+  // reference backend ("" = SAPMVS_DEVICE, else the default OpenCL device).
   std::string device;
   MatcherOptions matcher;
   // Its level and min_image_num are taken from the matcher's (Grouping()).
@@ -52,8 +53,9 @@ struct RunOptions {
   DsmOptions dsm;
   // cloud.las: LAS 1.2 by default, which every reader opens (las_io.h).
   LasVersion las_version = LasWriteOptions{}.version;
-  // Profile the device queue (CL_QUEUE_PROFILING_ENABLE): kernel device
-  // times in the report, and the profile tables (run_profile.h).
+  // Profile the device queue (CL_QUEUE_PROFILING_ENABLE; the reference's
+  // wall clock): kernel device times in the report, and the profile tables
+  // (run_profile.h).
   bool profile = false;
   // Not an option: the command line that asked for the run, for report.json.
   std::vector<std::string> command_line;
@@ -73,9 +75,10 @@ struct GroupRun {
   bool resumed = false;  // read from a checkpoint of an earlier call
 };
 
-// The OpenCL device a run used, as report.json names it.
+// The device a run used (an OpenCL device or the CPU reference), as
+// report.json names it.
 struct RunDevice {
-  std::string name;      // CL_DEVICE_NAME
+  std::string name;      // CL_DEVICE_NAME, or "reference"
   std::string vendor;    // CL_DEVICE_VENDOR
   std::string platform;  // CL_PLATFORM_NAME and CL_PLATFORM_VERSION
   std::string type;      // "GPU", "CPU" or "other"

@@ -1,0 +1,28 @@
+#include "patch_kernels.h"
+
+#include "cl_patch_kernels.h"
+#include "device_spec.h"
+#include "reference_patch_kernels.h"
+
+namespace sapmvs {
+
+bool SelectsReference(const PatchKernelsOptions& options) {
+  return IsReferenceSpec(DeviceSpecFor(options.device));
+}
+
+std::unique_ptr<PatchKernels> MakePatchKernels(const PatchKernelsOptions& options) {
+  if (SelectsReference(options)) return MakeReferencePatchKernels(options);
+  return MakeClPatchKernels(options);
+}
+
+KernelBatchBytes PatchKernelBatchBytes() {
+  KernelBatchBytes bytes;
+  // The refinement's buffers: the patches, their results and the view list
+  // offsets; per view of a patch, the scoring's pair and score and the
+  // refinement's view index and per-view score.
+  bytes.per_patch = sizeof(NccPatch) + sizeof(RefinedPatchOut) + 4;
+  bytes.per_pair = sizeof(NccPair) + 4 + 4;
+  return bytes;
+}
+
+}  // namespace sapmvs
