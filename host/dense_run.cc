@@ -12,6 +12,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "make_patch_kernels.h"
 #include "patch_kernels.h"
 #include "run_checkpoint.h"
 #include "run_progress.h"

@@ -1,18 +1,11 @@
 #include "patch_kernels.h"
 
-#include "cl_patch_kernels.h"
 #include "device_spec.h"
-#include "reference_patch_kernels.h"
 
 namespace sapmvs {
 
 bool SelectsReference(const PatchKernelsOptions& options) {
   return IsReferenceSpec(DeviceSpecFor(options.device));
-}
-
-std::unique_ptr<PatchKernels> MakePatchKernels(const PatchKernelsOptions& options) {
-  if (SelectsReference(options)) return MakeReferencePatchKernels(options);
-  return MakeClPatchKernels(options);
 }
 
 KernelBatchBytes PatchKernelBatchBytes() {

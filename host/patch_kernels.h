@@ -70,10 +70,6 @@ class PatchKernels {
 // reference.
 bool SelectsReference(const PatchKernelsOptions& options);
 
-// The backend `options` selects. The reference makes no OpenCL call at all;
-// an OpenCL device that cannot be found throws NoDeviceError.
-std::unique_ptr<PatchKernels> MakePatchKernels(const PatchKernelsOptions& options);
-
 // What a device holds per patch of a batch and per (patch, view) pair, beyond
 // the group's images: the planner's memory model (matcher.h MatcherMemory).
 struct KernelBatchBytes {

@@ -12,6 +12,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "make_patch_kernels.h"
 #include "patch_kernels.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"

@@ -4,6 +4,7 @@
 // against each other on a plane scene, at odd sizes and at the borders.
 
 #include "patch_kernels.h"
+#include "make_patch_kernels.h"
 
 #include <gtest/gtest.h>
 
