@@ -232,21 +232,8 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     end_stage("edges");
   }
 
-  // Gross errors: a point whose depth in its reference image is a far-out
-  // value of that image's seed depths (Tukey's fences, 3 interquartile ranges
-  // beyond the quartiles, plus 10 GSD) is a false match that grew into a
-  // cluster big enough to pass the cluster filter (on the NGI block, clusters
-  // kilometres below the ground). Quartiles, not the seeds' extremes: false
-  // seeds are among them.
-  std::vector<std::pair<double, double>> plausible(group.images.size(), {0.0, 0.0});
-  for (size_t i = 0; i < group.images.size(); ++i) {
-    std::vector<double> d = propagator.seed_depths()[i];
-    if (d.size() < 10) continue;
-    std::sort(d.begin(), d.end());
-    const double q1 = d[d.size() / 4], q3 = d[(3 * d.size()) / 4];
-    const double pad = 3.0 * (q3 - q1) + 10.0 * group.gsd;
-    plausible[i] = {q1 - pad, q3 + pad};
-  }
+  const std::vector<std::pair<double, double>> plausible =
+      SeedDepthFences(propagator.seed_depths(), group.gsd);
   const auto& points = propagator.points();
   const auto& patches = propagator.patches();
   std::vector<bool> keep;
@@ -262,33 +249,11 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     end_stage("propagation");
     report("filter", pass + 1, options.expand_iterations);
 
-    if (pass == 0) {
-      // The fence, from the scores of the points of the first expansion.
-      stats.score_floor = options.threshold;
-      if (options.score_fence > 0 && points.size() >= 10) {
-        std::vector<double> s;
-        for (const DensePoint& d : points) s.push_back(patches[d.patch].score);
-        std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
-        const double median = s[s.size() / 2];
-        for (double& v : s) v = std::abs(v - median);
-        std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
-        const double sigma = 1.4826 * s[s.size() / 2];
-        stats.score_floor = std::max(options.threshold, median - options.score_fence * sigma);
-      }
-    }
+    // The fence, from the scores of the points of the first expansion.
+    if (pass == 0) stats.score_floor = ScoreFloor(options, points, patches);
     MatchStats removed;
     keep = FilterPoints(group, options, points, patches, &removed, stats.score_floor);
-    for (size_t i = 0; i < points.size(); ++i) {
-      if (!keep[i]) continue;
-      const int ref = patches[points[i].patch].ref;
-      const auto [lo, hi] = plausible[ref];
-      if (lo == 0 && hi == 0) continue;
-      const double depth = group.images[ref].camera.Depth(points[i].x);
-      if (depth < lo || depth > hi) {
-        keep[i] = false;
-        ++stats.removed_depth_range;
-      }
-    }
+    stats.removed_depth_range += ApplyDepthFences(group, points, patches, plausible, &keep);
     stats.removed_score += removed.removed_score;
     stats.plane_tolerance = removed.plane_tolerance;
     stats.removed_visibility += removed.removed_visibility;

@@ -282,4 +282,53 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   return keep;
 }
 
+double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
+                  const std::vector<AcceptedPatch>& patches) {
+  double floor = options.threshold;
+  if (options.score_fence > 0 && points.size() >= 10) {
+    std::vector<double> s;
+    for (const DensePoint& d : points) s.push_back(patches[d.patch].score);
+    std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+    const double median = s[s.size() / 2];
+    for (double& v : s) v = std::abs(v - median);
+    std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+    const double sigma = 1.4826 * s[s.size() / 2];
+    floor = std::max(options.threshold, median - options.score_fence * sigma);
+  }
+  return floor;
+}
+
+std::vector<std::pair<double, double>> SeedDepthFences(
+    const std::vector<std::vector<double>>& seed_depths, double gsd) {
+  std::vector<std::pair<double, double>> fences(seed_depths.size(), {0.0, 0.0});
+  for (size_t i = 0; i < seed_depths.size(); ++i) {
+    std::vector<double> d = seed_depths[i];
+    if (d.size() < 10) continue;
+    std::sort(d.begin(), d.end());
+    const double q1 = d[d.size() / 4], q3 = d[(3 * d.size()) / 4];
+    const double pad = 3.0 * (q3 - q1) + 10.0 * gsd;
+    fences[i] = {q1 - pad, q3 + pad};
+  }
+  return fences;
+}
+
+long ApplyDepthFences(const MatchGroupData& group, const std::vector<DensePoint>& points,
+                      const std::vector<AcceptedPatch>& patches,
+                      const std::vector<std::pair<double, double>>& fences,
+                      std::vector<bool>* keep) {
+  long removed = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!(*keep)[i]) continue;
+    const int ref = patches[points[i].patch].ref;
+    const auto [lo, hi] = fences[ref];
+    if (lo == 0 && hi == 0) continue;
+    const double depth = group.images[ref].camera.Depth(points[i].x);
+    if (depth < lo || depth > hi) {
+      (*keep)[i] = false;
+      ++removed;
+    }
+  }
+  return removed;
+}
+
 }  // namespace sapmvs

@@ -19,6 +19,7 @@
 //     plane_tolerance footprints;
 //  3. clusters: points linked within neighbour_radius footprints form
 //     clusters; those smaller than min_cluster_size go.
+#include <utility>
 #include <vector>
 
 #include "match_group.h"
@@ -34,6 +35,29 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
                                double score_floor = 0);
+
+// The score floor of `points` (their patches' scores): `options.threshold`,
+// raised to median - score_fence robust standard deviations (1.4826 MAD)
+// when score_fence > 0 and there are at least 10 points. Taken from the first
+// expansion's points, it keeps the weakest matches of a block out.
+double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
+                  const std::vector<AcceptedPatch>& patches);
+
+// Per image, the depths a point may lie at in it as its reference: Tukey's
+// fences on the image's seed depths (3 interquartile ranges beyond the
+// quartiles) plus 10 `gsd`; (0, 0) = no fence, when an image has fewer than
+// 10 seeds. A false match can grow into a cluster big enough to pass the
+// cluster filter (on the NGI block, clusters kilometres below the ground);
+// quartiles, not the seeds' extremes, because false seeds are among them.
+std::vector<std::pair<double, double>> SeedDepthFences(
+    const std::vector<std::vector<double>>& seed_depths, double gsd);
+
+// Clears keep[i] for kept points outside their reference image's fence;
+// returns how many.
+long ApplyDepthFences(const MatchGroupData& group, const std::vector<DensePoint>& points,
+                      const std::vector<AcceptedPatch>& patches,
+                      const std::vector<std::pair<double, double>>& fences,
+                      std::vector<bool>* keep);
 
 // The visibility pass alone (tests): keep[i] after pass 1, among the points
 // where `eligible` is true (all when empty).

@@ -201,5 +201,40 @@ TEST(FilterPoints, ThePlaneToleranceFollowsTheNoiseBetweenPatches) {
   EXPECT_FALSE(b[outlier]);
 }
 
+TEST(SeedDepthFences, TukeyFencesPaddedByTenGsdAndNoneBelowTenSeeds) {
+  std::vector<std::vector<double>> depths(2);
+  for (int i = 0; i < 9; ++i) depths[0].push_back(100.0 + i);
+  // 20 depths 100..119, shuffled: the fence must not depend on their order.
+  for (int i = 0; i < 20; ++i) depths[1].push_back(100.0 + (i * 7) % 20);
+  const double gsd = 0.05;
+  const auto fences = SeedDepthFences(depths, gsd);
+  ASSERT_EQ(fences.size(), 2u);
+  EXPECT_EQ(fences[0], std::make_pair(0.0, 0.0)) << "9 seeds are too few for a fence";
+  // Quartiles of 100..119 at indices 5 and 15: 105 and 115.
+  const double pad = 3.0 * (115.0 - 105.0) + 10.0 * gsd;
+  EXPECT_DOUBLE_EQ(fences[1].first, 105.0 - pad);
+  EXPECT_DOUBLE_EQ(fences[1].second, 115.0 + pad);
+}
+
+TEST(ScoreFloor, ThresholdUnlessTheFenceLiesAboveIt) {
+  MatcherOptions options;
+  options.threshold = 0.7;
+  options.score_fence = 2.0;
+  std::vector<AcceptedPatch> patches(20);
+  std::vector<DensePoint> points(20);
+  for (int i = 0; i < 20; ++i) {
+    patches[i].score = 0.95f + 0.001f * static_cast<float>(i % 5);
+    points[i].patch = i;
+  }
+  const double tight = ScoreFloor(options, points, patches);
+  EXPECT_GT(tight, 0.9) << "scores within 0.004 of each other: the fence lies well above 0.7";
+  for (int i = 0; i < 10; ++i) patches[i].score = 0.3f + 0.06f * static_cast<float>(i);
+  EXPECT_DOUBLE_EQ(ScoreFloor(options, points, patches), options.threshold)
+      << "widely spread scores: the fence falls below the threshold";
+  options.score_fence = 0;
+  points.resize(5);
+  EXPECT_DOUBLE_EQ(ScoreFloor(options, points, patches), options.threshold);
+}
+
 }  // namespace
 }  // namespace sapmvs
