@@ -31,7 +31,8 @@
 #include "match_group.h"
 #include "ncc_scorer.h"
 #include "patch_refiner.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/match_stats.h"
+#include "sapmvs/matcher_options.h"
 
 namespace sapmvs {
 
