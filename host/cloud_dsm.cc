@@ -15,15 +15,7 @@
 
 namespace sapmvs {
 
-std::string DsmOptions::Problem() const {
-  std::ostringstream s;
-  if (!(std::isfinite(cell_size) && cell_size >= 0)) {
-    s << "a DSM cell size finite and >= 0, 0 = automatic (cell_size = " << cell_size << ")";
-  } else if (fill_passes < 0 || fill_passes > 10) {
-    s << "0 to 10 gap-filling passes (fill_passes = " << fill_passes << ")";
-  }
-  return s.str();
-}
+std::string DsmOptions::Problem() const { return FirstRangeProblem(*this); }
 
 double MeanPointSpacing(const PointCloud& cloud, size_t max_samples) {
   const size_t n = cloud.points.size();

@@ -19,11 +19,15 @@
 #include "run_report.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
+#include "sapmvs/cloud_dsm.h"
 #include "sapmvs/cloud_las.h"
+#include "sapmvs/cloud_merge.h"
 #include "sapmvs/dsm_picture.h"
 #include "sapmvs/error.h"
+#include "sapmvs/grouping.h"
 #include "sapmvs/las_io.h"
 #include "sapmvs/log.h"
+#include "sapmvs/matcher.h"
 #include "sapmvs/memory_use.h"
 #include "sapmvs/output_folder.h"
 #include "sapmvs/ply_io.h"
@@ -31,42 +35,6 @@
 #include "sapmvs/raster_io.h"
 
 namespace sapmvs {
-
-GroupingOptions RunOptions::Grouping() const {
-  GroupingOptions g = grouping;
-  g.level = matcher.level;
-  g.min_image_num = matcher.min_image_num;
-  return g;
-}
-
-std::string RunOptions::Problem() const {
-  if (block.empty()) return "a block path";
-  if (out.empty()) return "an output folder (--out)";
-  std::string p = matcher.Problem();
-  if (!p.empty()) return p;
-  p = Grouping().Problem();
-  if (!p.empty()) return p;
-  if (max_groups < 0) return "max_groups >= 0 (max_groups = " + std::to_string(max_groups) + ")";
-  if (!(std::isfinite(merge_radius_gsd) && merge_radius_gsd > 0)) {
-    std::ostringstream s;
-    s << "a merge radius > 0 GSD (merge_radius_gsd = " << merge_radius_gsd << ")";
-    return s.str();
-  }
-  return dsm.Problem();
-}
-
-bool RunOptions::Check() const {
-  const std::string p = Problem();
-  if (!p.empty()) std::cerr << "RunOptions: expected " << p << "\n";
-  return p.empty();
-}
-
-std::string FormatHms(double seconds) {
-  const long s = std::lround(std::max(0.0, seconds));
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
-  return buf;
-}
 
 namespace {
 
@@ -157,8 +125,7 @@ RunReport RunDense(const RunOptions& options) {
   if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
     throw Error(reason);
   }
-  const GroupingOptions gopt = options.Grouping();
-  const GroupingPlan plan = PlanGroups(block, gopt, &geometry);
+  const GroupingPlan plan = PlanGroups(block, options.grouping, options.matcher, &geometry);
   report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
   for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   end_stage("plan");

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "sapmvs/block.h"
-#include "sapmvs/evaluate.h"
+#include "sapmvs/dsm_completeness.h"
 #include "sapmvs/raster_io.h"
 
 namespace sapmvs {

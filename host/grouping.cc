@@ -16,6 +16,7 @@
 #include "sapmvs/error.h"
 #include "sapmvs/kernel_limits.h"
 #include "sapmvs/matcher.h"
+#include "sapmvs/matcher_options.h"
 #include "strip_detection.h"
 
 namespace sapmvs {
@@ -84,7 +85,7 @@ std::string GroupNames(const Block& block, const std::vector<int>& ids) {
 
 // Throws when the smallest useful group, the two largest images, does not
 // fit: every other pair then fits too, as the estimate grows with pixels.
-void CheckTwoImagesFit(const Block& block, const GroupingOptions& o) {
+void CheckTwoImagesFit(const Block& block, const GroupingOptions& o, const MatcherOptions& m) {
   std::vector<int> ids(block.images.size());
   std::iota(ids.begin(), ids.end(), 0);
   std::partial_sort(ids.begin(), ids.begin() + 2, ids.end(), [&](int a, int b) {
@@ -93,18 +94,19 @@ void CheckTwoImagesFit(const Block& block, const GroupingOptions& o) {
            static_cast<double>(cb.width()) * cb.height();
   });
   ids.resize(2);
-  const GroupMemory m = EstimateGroupMemory(block, ids, o.level);
-  if (m.Total() > o.memory_budget) {
+  const GroupMemory mem = EstimateGroupMemory(block, ids, m);
+  if (mem.Total() > o.memory_budget) {
     throw Error("memory budget " + FormatBytes(o.memory_budget) +
                 " is too small: a group of 2 images (" + GroupNames(block, ids) + ") needs " +
-                FormatBytes(m.Total()) + " at level " + std::to_string(o.level) + " (device " +
-                FormatBytes(m.device_bytes) + " + host " + FormatBytes(m.host_bytes) +
+                FormatBytes(mem.Total()) + " at level " + std::to_string(m.level) + " (device " +
+                FormatBytes(mem.device_bytes) + " + host " + FormatBytes(mem.host_bytes) +
                 "); raise the budget or match at a coarser level");
   }
 }
 
-bool Fits(const Block& block, const std::vector<int>& ids, const GroupingOptions& o) {
-  return EstimateGroupMemory(block, ids, o.level).Total() <= o.memory_budget;
+// The plan's options and matcher say what a group may use.
+bool Fits(const Block& block, const std::vector<int>& ids, const GroupingPlan& plan) {
+  return EstimateGroupMemory(block, ids, plan.matcher).Total() <= plan.options.memory_budget;
 }
 
 Eigen::Vector2d MeanCenter(const std::vector<Footprint>& fp, const std::vector<int>& ids) {
@@ -172,7 +174,7 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
     for (int k = o.max_images; k >= 2; --k) {
       runs = CutRuns(strip, static_cast<size_t>(k));
       if (std::all_of(runs.begin(), runs.end(),
-                      [&](const std::vector<int>& r) { return Fits(block, r, o); }))
+                      [&](const std::vector<int>& r) { return Fits(block, r, *plan); }))
         break;
     }
     // A run of fewer images than a patch needs matches nothing (a strip of
@@ -181,11 +183,11 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
     for (size_t r = 1; r < runs.size(); ++r) {
       std::vector<int>& run = runs[r];
       auto first = std::find(strip.begin(), strip.end(), run.front());
-      while (static_cast<int>(run.size()) < std::min(o.min_image_num, o.max_images) &&
+      while (static_cast<int>(run.size()) < std::min(plan->matcher.min_image_num, o.max_images) &&
              first != strip.begin()) {
         std::vector<int> with = run;
         with.insert(with.begin(), *(first - 1));
-        if (!Fits(block, with, o)) break;
+        if (!Fits(block, with, *plan)) break;
         run = std::move(with);
         --first;
       }
@@ -223,7 +225,7 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
       ImageGroup& g = plan->groups[gi];
       std::vector<int> with = g.images;
       with.push_back(i);
-      if (static_cast<int>(with.size()) > o.max_images || !Fits(block, with, o)) continue;
+      if (static_cast<int>(with.size()) > o.max_images || !Fits(block, with, *plan)) continue;
       g.images = std::move(with);
       g.center = MeanCenter(fp, g.images);
       joined = true;
@@ -348,7 +350,7 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
           if (gain > 0 && (best < 0 || key > best_key)) {
             std::vector<int> with = g.images;
             with.push_back(candidates[c].image);
-            if (!Fits(block, with, o)) continue;
+            if (!Fits(block, with, *plan)) continue;
             best = static_cast<int>(c);
             best_key = key;
           }
@@ -402,22 +404,7 @@ GroupingStrategy ParseGroupingStrategy(const std::string& text) {
   throw Error("unknown grouping strategy '" + text + "': expected strip or footprint");
 }
 
-std::string GroupingOptions::Problem() const {
-  std::ostringstream s;
-  if (max_images < 2)
-    s << "max_images >= 2 (max_images = " << max_images << ")";
-  else if (!(memory_budget > 0 && std::isfinite(memory_budget)))
-    s << "memory_budget > 0 bytes (memory_budget = " << memory_budget << ")";
-  else if (level < 0 || level > kMaxLevel)
-    s << "level in 0.." << kMaxLevel << " (level = " << level << ")";
-  else if (!(tile_size > 0 && tile_size <= 4))
-    s << "tile_size in (0, 4] (tile_size = " << tile_size << ")";
-  else if (tile_views < 2)
-    s << "tile_views >= 2 (tile_views = " << tile_views << ")";
-  else if (min_image_num < 2 || min_image_num > kMaxViews)
-    s << "min_image_num in 2.." << kMaxViews << " (min_image_num = " << min_image_num << ")";
-  return s.str();
-}
+std::string GroupingOptions::Problem() const { return FirstRangeProblem(*this); }
 
 bool GroupingOptions::Check() const {
   const std::string problem = Problem();
@@ -459,17 +446,20 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
 }
 
 GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
-                        const BlockGeometry* known_geometry) {
+                        const MatcherOptions& matcher, const BlockGeometry* known_geometry) {
   if (const std::string problem = options.Problem(); !problem.empty())
     throw Error("grouping options: expected " + problem);
+  if (const std::string problem = matcher.Problem(); !problem.empty())
+    throw Error("matcher options: expected " + problem);
   if (block.images.size() < 2) {
     throw Error("grouping needs at least 2 images, " + block.source.string() + " has " +
                 std::to_string(block.images.size()));
   }
-  CheckTwoImagesFit(block, options);
+  CheckTwoImagesFit(block, options, matcher);
   GroupingPlan plan;
   plan.strategy = options.strategy;
   plan.options = options;
+  plan.matcher = matcher;
   plan.strips = DetectStrips(block);
   const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
   if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
@@ -485,20 +475,20 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   ImageGroup all;
   all.images.resize(block.images.size());
   std::iota(all.images.begin(), all.images.end(), 0);
-  all.memory = EstimateGroupMemory(block, all.images, options.level);
+  all.memory = EstimateGroupMemory(block, all.images, matcher);
   if (static_cast<int>(all.images.size()) <= options.max_images &&
       all.memory.Total() <= options.memory_budget) {
     for (const int i : all.images) all.center += fp[i].center;
     all.center /= static_cast<double>(all.images.size());
-    all.short_of_views = ShortOfViews(fp, all.images, options.min_image_num);
+    all.short_of_views = ShortOfViews(fp, all.images, matcher.min_image_num);
     plan.groups.assign(1, all);
     plan.ungrouped.clear();
     plan.single_group = true;
     return plan;
   }
   for (ImageGroup& g : plan.groups) {
-    g.memory = EstimateGroupMemory(block, g.images, options.level);
-    g.short_of_views = ShortOfViews(fp, g.images, options.min_image_num);
+    g.memory = EstimateGroupMemory(block, g.images, matcher);
+    g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num);
   }
   return plan;
 }

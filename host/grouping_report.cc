@@ -42,7 +42,7 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
   for (const auto& s : plan.strips) out << " " << s.size();
   out << " images\n";
   out << "strategy    " << ToString(plan.strategy) << ": at most " << o.max_images
-      << " images per group, level " << o.level << ", memory budget "
+      << " images per group, level " << plan.matcher.level << ", memory budget "
       << FormatBytes(o.memory_budget);
   if (plan.strategy == GroupingStrategy::kFootprint)
     out << ", tiles of " << Fixed(o.tile_size, 2) << " footprint, " << o.tile_views << " views";
@@ -82,7 +82,7 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
     if (plan.groups[g].short_of_views.empty()) continue;
     out << "note        group " << g + 1 << ": image(s)";
     for (const int i : plan.groups[g].short_of_views) out << " " << block.images[i].name;
-    out << " overlap fewer than " << o.min_image_num - 1
+    out << " overlap fewer than " << plan.matcher.min_image_num - 1
         << " other images of the group and cannot be matched there\n";
   }
   if (!plan.ungrouped.empty()) {
@@ -110,9 +110,9 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["strategy"] = ToString(plan.strategy);
   j["single_group"] = plan.single_group;
-  j["options"] = {{"max_images", o.max_images}, {"memory_budget", o.memory_budget},
-                  {"level", o.level},           {"tile_size", o.tile_size},
-                  {"tile_views", o.tile_views}, {"min_image_num", o.min_image_num}};
+  j["options"] = {{"max_images", o.max_images},  {"memory_budget", o.memory_budget},
+                  {"level", plan.matcher.level}, {"tile_size", o.tile_size},
+                  {"tile_views", o.tile_views},  {"min_image_num", plan.matcher.min_image_num}};
   j["strips"] = json::array();
   for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
   j["groups"] = json::array();

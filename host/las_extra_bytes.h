@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "sapmvs/las_io.h"
+#include "sapmvs/las_extra_field.h"
 
 namespace sapmvs::las {
 

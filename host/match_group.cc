@@ -8,7 +8,7 @@
 #include "sapmvs/error.h"
 #include "sapmvs/image_io.h"
 #include "sapmvs/kernel_limits.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/matcher_options.h"
 
 namespace sapmvs {
 

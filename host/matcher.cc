@@ -24,68 +24,6 @@
 namespace sapmvs {
 namespace {
 
-std::string FirstProblem(const MatcherOptions& o) {
-  std::ostringstream s;
-  if (o.level < 0 || o.level > kMaxLevel)
-    s << "level in 0.." << kMaxLevel << " (level = " << o.level << ")";
-  else if (o.cell_size < 1 || o.cell_size > 16)
-    s << "cell_size in 1..16 (cell_size = " << o.cell_size << ")";
-  else if (!(o.threshold > -1 && o.threshold <= 1))
-    s << "threshold in (-1, 1] (threshold = " << o.threshold << ")";
-  else if (!(o.threshold_before > -1 && o.threshold_before <= o.threshold))
-    s << "threshold_before in (-1, threshold] (threshold_before = " << o.threshold_before << ")";
-  else if (o.min_image_num < 2 || o.min_image_num > kMaxViews)
-    s << "min_image_num in 2.." << kMaxViews << " (min_image_num = " << o.min_image_num << ")";
-  else if (!(o.max_angle_deg >= 0 && o.max_angle_deg < 90))
-    s << "max_angle_deg in [0, 90) (max_angle_deg = " << o.max_angle_deg << ")";
-  else if (!(o.view_angle_deg > 0 && o.view_angle_deg < 90))
-    s << "view_angle_deg in (0, 90) (view_angle_deg = " << o.view_angle_deg << ")";
-  else if (o.window_size < 3 || o.window_size > kMaxPatchSize || o.window_size % 2 == 0)
-    s << "window_size odd in 3.." << kMaxPatchSize << " (window_size = " << o.window_size << ")";
-  else if (o.features_per_block < 1)
-    s << "features_per_block >= 1";
-  else if (!(o.epipolar_distance > 0))
-    s << "epipolar_distance > 0";
-  else if (o.candidates_per_feature < 1)
-    s << "candidates_per_feature >= 1";
-  else if (o.max_wave < 1)
-    s << "max_wave >= 1";
-  else if (o.max_waves < 0)
-    s << "max_waves >= 0";
-  else if (!(o.depth_tolerance > 0))
-    s << "depth_tolerance > 0";
-  else if (!(o.neighbour_radius > 0))
-    s << "neighbour_radius > 0";
-  else if (o.min_neighbours < 0)
-    s << "min_neighbours >= 0";
-  else if (!(o.plane_tolerance > 0))
-    s << "plane_tolerance > 0";
-  else if (o.min_cluster_size < 0)
-    s << "min_cluster_size >= 0";
-  else if (!(o.plane_sigmas >= 0))
-    s << "plane_sigmas >= 0";
-  else if (!(o.score_fence >= 0))
-    s << "score_fence >= 0";
-  else if (!(std::isfinite(o.ncc_sigma_color) && o.ncc_sigma_color >= 0))
-    s << "ncc_sigma_color finite and >= 0 (ncc_sigma_color = " << o.ncc_sigma_color << ")";
-  else if (o.expand_iterations < 1 || o.expand_iterations > 10)
-    s << "expand_iterations in 1..10";
-  if (!s.str().empty()) return s.str();
-  // PMVS uses window_size alone and ignores adaptive_sizes.
-  if (o.mode == MatchMode::kSapmvs) {
-    if (o.adaptive_sizes.empty() || o.adaptive_sizes.back() != o.window_size) {
-      return "adaptive_sizes ending with window_size (" + std::to_string(o.window_size) + ")";
-    }
-    for (size_t i = 0; i < o.adaptive_sizes.size(); ++i) {
-      const int v = o.adaptive_sizes[i];
-      if (v < 3 || v > kMaxPatchSize || v % 2 == 0 || (i > 0 && v >= o.adaptive_sizes[i - 1])) {
-        return "adaptive_sizes odd, decreasing, in 3.." + std::to_string(kMaxPatchSize);
-      }
-    }
-  }
-  return "";
-}
-
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
@@ -97,22 +35,6 @@ double DeviceSeconds(const PatchEngine& engine) {
 }
 
 }  // namespace
-
-std::string ToString(MatchMode mode) { return mode == MatchMode::kSapmvs ? "sapmvs" : "pmvs"; }
-
-MatchMode ParseMatchMode(const std::string& text) {
-  if (text == "sapmvs") return MatchMode::kSapmvs;
-  if (text == "pmvs") return MatchMode::kPmvs;
-  throw Error("unknown matching mode '" + text + "': expected sapmvs or pmvs");
-}
-
-std::string MatcherOptions::Problem() const { return FirstProblem(*this); }
-
-bool MatcherOptions::Check() const {
-  const std::string problem = Problem();
-  if (!problem.empty()) std::cerr << "MatcherOptions: expected " << problem << "\n";
-  return problem.empty();
-}
 
 MatcherMemoryModel MatcherMemory() {
   const double views = kMaxViews - 1;

@@ -4,19 +4,10 @@
 #include <cmath>
 
 #include "sapmvs/error.h"
+#include "sapmvs/kernel_limits.h"
 
 namespace sapmvs {
 namespace {
-
-// Polishing a refined 7 x 7 patch at a larger size. Its depth is already
-// within a fraction of a footprint, but a 7 x 7 window pins its normal down
-// only to several degrees, and a large patch's corners magnify that: 6
-// rounds from 2 degree steps could neither move the normal far enough nor
-// refine it below the 2 degree grid (`small` at level 0: 90.1 % of the
-// points within 1 GSD; 8 rounds from 4 degrees: 92.9 %, for 5 % more time).
-constexpr int kPolishIterations = 8;
-constexpr double kPolishDepthStep = 0.25;
-constexpr double kPolishAngleStepDeg = 4.0;
 
 // True when image `camera` sees the plane (c, n) at most view_angle off its normal.
 bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,

@@ -29,7 +29,8 @@
 
 #include "match_group.h"
 #include "patch_kernels.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/match_stats.h"
+#include "sapmvs/matcher_options.h"
 
 namespace sapmvs {
 

@@ -24,7 +24,8 @@
 
 #include "match_group.h"
 #include "propagation.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/match_stats.h"
+#include "sapmvs/matcher_options.h"
 
 namespace sapmvs {
 

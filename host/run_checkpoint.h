@@ -9,7 +9,8 @@
 
 #include "sapmvs/block.h"
 #include "sapmvs/grouping.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/match_stats.h"
+#include "sapmvs/matcher_options.h"
 #include "sapmvs/ply_io.h"
 
 namespace sapmvs {

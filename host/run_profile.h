@@ -22,7 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "sapmvs/dense_run.h"
+#include "sapmvs/match_stats.h"
+#include "sapmvs/run_result.h"
 
 namespace sapmvs {
 

@@ -1,10 +1,13 @@
 #include "run_report.h"
 
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 
 #include "build_info.h"
 #include "machine_info.h"
+#include "option_json.h"
 #include "sapmvs/atomic_file.h"
 #include "sapmvs/error.h"
 #include "sapmvs/log.h"
@@ -13,39 +16,18 @@
 
 namespace sapmvs {
 
+std::string FormatHms(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  return buf;
+}
+
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
   WriteStreamAtomically(path, [&](std::ostream& f) { f << std::setw(2) << j << "\n"; });
 }
 
-nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
-  return {{"mode", ToString(m.mode)},
-          {"level", m.level},
-          {"cell_size", m.cell_size},
-          {"threshold", m.threshold},
-          {"threshold_before", m.threshold_before},
-          {"min_image_num", m.min_image_num},
-          {"max_angle_deg", m.max_angle_deg},
-          {"view_angle_deg", m.view_angle_deg},
-          {"window_size", m.window_size},
-          {"adaptive_sizes", m.adaptive_sizes},
-          {"ncc_sigma_color", m.ncc_sigma_color},
-          {"features_per_block", m.features_per_block},
-          {"epipolar_distance", m.epipolar_distance},
-          {"candidates_per_feature", m.candidates_per_feature},
-          {"canny_low", m.canny_low},
-          {"canny_high", m.canny_high},
-          {"use_edges", m.use_edges},
-          {"max_wave", m.max_wave},
-          {"max_waves", m.max_waves},
-          {"expand_iterations", m.expand_iterations},
-          {"score_fence", m.score_fence},
-          {"depth_tolerance", m.depth_tolerance},
-          {"neighbour_radius", m.neighbour_radius},
-          {"min_neighbours", m.min_neighbours},
-          {"plane_tolerance", m.plane_tolerance},
-          {"plane_sigmas", m.plane_sigmas},
-          {"min_cluster_size", m.min_cluster_size}};
-}
+nlohmann::json MatcherOptionsJson(const MatcherOptions& m) { return OptionsJson(m); }
 
 nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   nlohmann::json j;

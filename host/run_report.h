@@ -4,9 +4,11 @@
 #include <nlohmann/json.hpp>
 
 #include "sapmvs/block.h"
-#include "sapmvs/dense_run.h"
 #include "sapmvs/grouping.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/match_stats.h"
+#include "sapmvs/matcher_options.h"
+#include "sapmvs/run_options.h"
+#include "sapmvs/run_result.h"
 
 namespace sapmvs {
 

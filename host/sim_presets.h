@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "sapmvs/flight_plan.h"
 #include "sapmvs/rotation.h"
 #include "sapmvs/sim_scene.h"
-#include "sapmvs/simulate.h"
 
 namespace sapmvs::sim {
 

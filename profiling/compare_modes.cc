@@ -3,7 +3,7 @@
 // surface, and the ratios. Both modes share one OpenCL context, so kernels
 // are compiled before the first timing starts.
 //
-//   compare_modes BLOCK --truth DSM [--level N] [--csv FILE]
+//   compare_modes BLOCK --truth DSM [--csv FILE] [matcher flags of `sapmvs run`]
 #include <CLI/CLI.hpp>
 
 #include <chrono>
@@ -13,6 +13,7 @@
 #include <iostream>
 
 #include "make_patch_kernels.h"
+#include "option_flags.h"
 #include "patch_kernels.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
@@ -34,10 +35,8 @@ struct Row {
 int main(int argc, char** argv) {
   CLI::App app("SAPMVS vs PMVS on one block, against its true surface");
   std::string block_path, truth_path, csv_path, device;
-  int level = 1;
   app.add_option("block", block_path, "Block file or folder")->required();
   app.add_option("--truth", truth_path, "True surface raster (truth/dsm.tif)")->required();
-  app.add_option("--level", level, "Pyramid level")->capture_default_str();
   app.add_option("--device", device, "OpenCL device, or reference (the CPU reference)");
   app.add_option("--csv", csv_path, "Write the rows as CSV");
   double coverage_cells = 1;
@@ -51,26 +50,13 @@ int main(int argc, char** argv) {
   app.add_flag("--window-bound", window_bound,
                "Also print the coverage a window matcher could reach at all "
                "(WindowCoverageBound, half-width wsize/2 working pixels)");
-  app.add_option("--threshold", base.threshold, "MatcherOptions::threshold");
-  app.add_option("--view-angle", base.view_angle_deg, "MatcherOptions::view_angle_deg");
-  app.add_option("--min-image-num", base.min_image_num, "MatcherOptions::min_image_num");
-  app.add_option("--depth-tolerance", base.depth_tolerance, "MatcherOptions::depth_tolerance");
-  app.add_option("--plane-tolerance", base.plane_tolerance, "MatcherOptions::plane_tolerance");
-  app.add_option("--plane-sigmas", base.plane_sigmas, "MatcherOptions::plane_sigmas");
-  app.add_option("--score-fence", base.score_fence, "MatcherOptions::score_fence");
-  app.add_option("--expand-iterations", base.expand_iterations,
-                 "MatcherOptions::expand_iterations");
-  app.add_option("--ncc-sigma-color", base.ncc_sigma_color, "MatcherOptions::ncc_sigma_color");
-  app.add_option("--wsize", base.window_size, "MatcherOptions::window_size");
-  app.add_option("--features-per-block", base.features_per_block,
-                 "MatcherOptions::features_per_block");
-  app.add_option("--candidates", base.candidates_per_feature,
-                 "MatcherOptions::candidates_per_feature");
-  app.add_option("--csize", base.cell_size, "MatcherOptions::cell_size");
-  app.add_option("--adaptive-sizes", base.adaptive_sizes, "MatcherOptions::adaptive_sizes")
-      ->delimiter(',');
+  // Every matcher flag of `sapmvs run` but --mode (both modes run here).
+  cli::AddOptionFlags(&app, &base, cli::CompareModesMatcherFields());
   CLI11_PARSE(app, argc, argv);
   try {
+    if (const std::string problem = base.Problem(); !problem.empty())
+      throw Error("expected " + problem);
+    const int level = base.level;
     const Block block = ReadBlock(block_path);
     // With the simulator's classes.tif beside the truth the rows split by class.
     const Truth truth_data = ReadTruth(truth_path);
@@ -90,7 +76,6 @@ int main(int argc, char** argv) {
     for (const MatchMode mode : modes) {
       MatcherOptions o = base;
       o.mode = mode;
-      o.level = level;
       o.progress = false;
       // Warm-up on a tiny budget compiles every kernel of this mode.
       MatcherOptions warm = o;

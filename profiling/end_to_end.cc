@@ -8,7 +8,7 @@
 //
 //   end_to_end [--presets small,campus,city] [--work /tmp/sapmvs_e2e]
 //              [--csv profiling/results/end_to_end.csv]
-//              [--chart profiling/results/end_to_end.png] [--level 1]
+//              [--chart profiling/results/end_to_end.png] [matcher flags of `sapmvs run`]
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -19,6 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "option_flags.h"
 #include "run_profile.h"
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/block_reader.h"
@@ -94,15 +95,19 @@ int main(int argc, char** argv) {
   std::vector<std::string> presets = {"small", "campus", "city"};
   std::string work = "/tmp/sapmvs_e2e", csv_path = "profiling/results/end_to_end.csv";
   std::string chart_path = "profiling/results/end_to_end.png", device;
-  int level = 1;
+  MatcherOptions base;
   app.add_option("--presets", presets, "Simulator presets")->delimiter(',')->capture_default_str();
   app.add_option("--work", work, "Folder for the simulated blocks and runs")->capture_default_str();
   app.add_option("--csv", csv_path, "CSV to write")->capture_default_str();
   app.add_option("--chart", chart_path, "PNG chart to write")->capture_default_str();
-  app.add_option("--level", level, "Pyramid level")->capture_default_str();
   app.add_option("--device", device, "OpenCL device");
+  // Every matcher flag of `sapmvs run` but --mode (both modes run here).
+  cli::AddOptionFlags(&app, &base, cli::CompareModesMatcherFields());
   CLI11_PARSE(app, argc, argv);
   try {
+    if (const std::string problem = base.Problem(); !problem.empty())
+      throw Error("expected " + problem);
+    const int level = base.level;
     std::vector<Row> rows;
     for (const std::string& preset : presets) {
       const fs::path sim = fs::path(work) / preset;
@@ -125,8 +130,8 @@ int main(int argc, char** argv) {
         o.device = device;
         o.restart = true;
         o.profile = true;
+        o.matcher = base;
         o.matcher.mode = ParseMatchMode(mode);
-        o.matcher.level = level;
         o.matcher.progress = false;
         const RunReport report = RunDense(o);
         WriteProfile(report, o.out / "profile.csv");  // and profile.json

@@ -10,6 +10,7 @@
 
 #include "sapmvs/block_geometry.h"
 #include "sapmvs/error.h"
+#include "sapmvs/simulate.h"
 #include "sim_presets.h"
 #include "strip_detection.h"
 
@@ -83,7 +84,7 @@ std::vector<std::vector<int>> TrueStrips(const SimBlock& s) {
 TEST(GroupingTable3, CampusStripStrategyMatchesThePaper) {
   const SimBlock s = MakeSimBlock("campus");
   ASSERT_EQ(s.block.images.size(), 67u);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   EXPECT_EQ(plan.strategy, GroupingStrategy::kStrip);
   EXPECT_EQ(plan.strips, TrueStrips(s));
   EXPECT_EQ(Sizes(plan), (std::vector<size_t>{6, 6, 4, 6, 6, 5, 6, 6, 6, 6, 6, 4}));
@@ -111,21 +112,21 @@ TEST(GroupingSingle, ABlockThatFitsIsOneGroupAndALargerOneIsSplit) {
   for (const GroupingStrategy strategy : {GroupingStrategy::kStrip, GroupingStrategy::kFootprint}) {
     GroupingOptions o;
     o.strategy = strategy;
-    const GroupingPlan one = PlanGroups(s.block, o);
+    const GroupingPlan one = PlanGroups(s.block, o, MatcherOptions{});
     EXPECT_TRUE(one.single_group);
     ASSERT_EQ(one.groups.size(), 1u);
     EXPECT_EQ(one.groups[0].images, (std::vector<int>{0, 1, 2, 3}));
     EXPECT_GT(one.groups[0].memory.Total(), 0);
 
     o.max_images = 3;  // fewer than the block's images
-    const GroupingPlan split = PlanGroups(s.block, o);
+    const GroupingPlan split = PlanGroups(s.block, o, MatcherOptions{});
     EXPECT_FALSE(split.single_group);
     EXPECT_GT(split.groups.size(), 1u);
 
     o.max_images = 6;
     // Three images fit, the whole block does not.
-    o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, o.level).Total();
-    const GroupingPlan budget = PlanGroups(s.block, o);
+    o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, MatcherOptions{}).Total();
+    const GroupingPlan budget = PlanGroups(s.block, o, MatcherOptions{});
     EXPECT_FALSE(budget.single_group);
     for (const ImageGroup& g : budget.groups) EXPECT_LE(g.memory.Total(), o.memory_budget);
   }
@@ -133,7 +134,7 @@ TEST(GroupingSingle, ABlockThatFitsIsOneGroupAndALargerOneIsSplit) {
 
 TEST(GroupingTable3, GroupCentresLieOnTheirImagesFootprints) {
   const SimBlock s = MakeSimBlock("campus");
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   for (const ImageGroup& g : plan.groups) {
     // Nadir images: the footprint centre is near the camera's XY.
     Eigen::Vector2d cams = Eigen::Vector2d::Zero();
@@ -158,13 +159,13 @@ TEST(GroupingStrips, ShuffledOrderGivesTheSameStripsInFlightOrder) {
   const auto expected = StripNames(s.block, TrueStrips(s));
   std::mt19937 rng(7);
   std::shuffle(s.block.images.begin(), s.block.images.end(), rng);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   EXPECT_EQ(StripNames(s.block, plan.strips), expected);
   // Same cut as in flight order: 6+6+4, 6+6+5, 6+6+6, 6+6+4 and the cross strip's.
   std::vector<size_t> sizes = Sizes(plan);
   std::sort(sizes.begin(), sizes.end());
   SimBlock ordered = MakeSimBlock("campus", true);
-  std::vector<size_t> want = Sizes(PlanGroups(ordered.block, GroupingOptions{}));
+  std::vector<size_t> want = Sizes(PlanGroups(ordered.block, GroupingOptions{}, MatcherOptions{}));
   std::sort(want.begin(), want.end());
   EXPECT_EQ(sizes, want);
 }
@@ -172,7 +173,7 @@ TEST(GroupingStrips, ShuffledOrderGivesTheSameStripsInFlightOrder) {
 TEST(GroupingStrips, SingleStrip) {
   const SimBlock s = MakeSimBlock("campus", false, {2});
   ASSERT_EQ(s.block.images.size(), 18u);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   ASSERT_EQ(plan.strips.size(), 1u);
   std::vector<int> all(18);
   std::iota(all.begin(), all.end(), 0);
@@ -183,7 +184,7 @@ TEST(GroupingStrips, SingleStrip) {
 TEST(GroupingStrips, StripFlownBackwardsKeepsFlightOrder) {
   // Strip 1 flies -X: its images in flight order have decreasing X.
   const SimBlock s = MakeSimBlock("campus", false, {1});
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   ASSERT_EQ(plan.strips.size(), 1u);
   const auto& strip = plan.strips[0];
   for (size_t k = 1; k < strip.size(); ++k) {
@@ -195,7 +196,7 @@ TEST(GroupingStrips, StripFlownBackwardsKeepsFlightOrder) {
   SimBlock shuffled = s;
   std::mt19937 rng(3);
   std::shuffle(shuffled.block.images.begin(), shuffled.block.images.end(), rng);
-  const auto strips = PlanGroups(shuffled.block, GroupingOptions{}).strips;
+  const auto strips = PlanGroups(shuffled.block, GroupingOptions{}, MatcherOptions{}).strips;
   EXPECT_EQ(StripNames(shuffled.block, strips), StripNames(s.block, plan.strips));
 }
 
@@ -205,17 +206,17 @@ TEST(GroupingStrips, RemainderOfOneBorrowsFromThePreviousRun) {
   s.block.images.resize(13);
   // 6 + 5 + 2, and the run of 2 takes image 10 too: a patch needs 3 images
   // (min_image_num), so a group of 2 would match nothing.
-  const GroupingPlan plan13 = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan13 = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   EXPECT_EQ(Sizes(plan13), (std::vector<size_t>{6, 5, 3}));
   EXPECT_EQ(plan13.groups[2].images.front(), plan13.groups[1].images.back());
   for (const ImageGroup& g : plan13.groups) EXPECT_TRUE(g.short_of_views.empty());
-  GroupingOptions pairs;
+  MatcherOptions pairs;
   pairs.min_image_num = 2;
-  EXPECT_EQ(Sizes(PlanGroups(s.block, pairs)), (std::vector<size_t>{6, 5, 2}));
+  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{}, pairs)), (std::vector<size_t>{6, 5, 2}));
   GroupingOptions two;
   two.max_images = 2;
   s.block.images.resize(5);
-  const GroupingPlan plan = PlanGroups(s.block, two);
+  const GroupingPlan plan = PlanGroups(s.block, two, MatcherOptions{});
   ASSERT_EQ(plan.groups.size(), 3u);
   EXPECT_EQ(plan.groups[2].images, (std::vector<int>{3, 4}));  // shares image 3
 }
@@ -230,7 +231,7 @@ TEST(GroupingStrips, LoneImageJoinsTheNearestGroup) {
   stray.camera = Camera::FromAngles(c.intrinsics(), c.center(), 0, 0, 90,
                                     AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
   s.block.images.push_back(stray);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
   EXPECT_EQ(plan.strips.size(), 2u);
   EXPECT_TRUE(plan.ungrouped.empty());
   int holder = -1;
@@ -279,7 +280,7 @@ TEST(GroupingFootprint, EveryGroundPointSeenTwiceIsOwnedByAGroupThatSeesIt) {
   const SimBlock s = MakeSimBlock("campus");
   GroupingOptions o;
   o.strategy = GroupingStrategy::kFootprint;
-  const GroupingPlan plan = PlanGroups(s.block, o);
+  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   ASSERT_FALSE(plan.groups.empty());
   int matchable = 0, in_tile = 0, owner_sees = 0;
   for (const GroundSample& p : SampleGround(s.block, 40)) {
@@ -309,7 +310,7 @@ TEST(GroupingFootprint, NoTwoGroupsMatchTheSameImages) {
     GroupingOptions o;
     o.strategy = GroupingStrategy::kFootprint;
     o.tile_size = 0.5;  // small tiles: neighbours often choose alike
-    const GroupingPlan plan = PlanGroups(s.block, o);
+    const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
     std::set<std::vector<int>> sets;
     for (const ImageGroup& g : plan.groups) {
       std::vector<int> ids = g.images;
@@ -326,9 +327,9 @@ TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
   o.max_images = 5;
   o.tile_views = 5;
   // Room for 3 images of the block, not 4.
-  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, o.level).Total() + 1;
-  ASSERT_GT(EstimateGroupMemory(s.block, {0, 1, 2, 3}, o.level).Total(), o.memory_budget);
-  const GroupingPlan plan = PlanGroups(s.block, o);
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, MatcherOptions{}).Total() + 1;
+  ASSERT_GT(EstimateGroupMemory(s.block, {0, 1, 2, 3}, MatcherOptions{}).Total(), o.memory_budget);
+  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   ASSERT_FALSE(plan.groups.empty());
   for (const ImageGroup& g : plan.groups) {
     EXPECT_GE(g.images.size(), 2u);
@@ -339,14 +340,15 @@ TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
     EXPECT_TRUE((g.center.array() < g.tile_max.array()).all());
   }
   o.memory_budget = 8.0 * (1ull << 30);
-  for (const ImageGroup& g : PlanGroups(s.block, o).groups) EXPECT_LE(g.images.size(), 5u);
+  for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups)
+    EXPECT_LE(g.images.size(), 5u);
 }
 
 TEST(GroupingFootprint, SideOverlapBringsImagesOfNeighbouringStrips) {
   const SimBlock s = MakeSimBlock("campus");
   GroupingOptions o;
   o.strategy = GroupingStrategy::kFootprint;
-  const GroupingPlan plan = PlanGroups(s.block, o);
+  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   int mixed = 0;
   for (const ImageGroup& g : plan.groups) {
     std::set<int> strips;
@@ -395,7 +397,7 @@ TEST(GroupingMemory, TinyBudgetIsAClearError) {
   GroupingOptions o;
   o.memory_budget = 1 << 20;
   try {
-    PlanGroups(s.block, o);
+    PlanGroups(s.block, o, MatcherOptions{});
     FAIL() << "expected an error";
   } catch (const Error& e) {
     const std::string what = e.what();
@@ -412,7 +414,7 @@ TEST(GroupingMemory, BudgetShortensTheRunsOfAStrip) {
   const SimBlock s = MakeSimBlock("campus");
   GroupingOptions o;
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + 1;
-  const GroupingPlan plan = PlanGroups(s.block, o);
+  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   // 16 -> 4+4+4+4, 17 -> 4+4+4+3+2, 18 -> 4+4+4+4+2, 16 -> 4+4+4+4, each
   // run of 2 taking the image before it (min_image_num 3).
   EXPECT_EQ(Sizes(plan),
@@ -435,14 +437,6 @@ TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {
             std::string::npos);
   EXPECT_NE(problem([](GroupingOptions& o) { o.memory_budget = NAN; }).find("memory_budget"),
             std::string::npos);
-  EXPECT_NE(problem([](GroupingOptions& o) { o.level = -1; }).find("level = -1"),
-            std::string::npos);
-  EXPECT_NE(problem([](GroupingOptions& o) { o.level = 7; }).find("level = 7"), std::string::npos);
-  EXPECT_EQ(problem([](GroupingOptions& o) { o.level = 6; }), "");
-  EXPECT_NE(problem([](GroupingOptions& o) { o.min_image_num = 1; }).find("min_image_num = 1"),
-            std::string::npos);
-  EXPECT_NE(problem([](GroupingOptions& o) { o.min_image_num = 9; }).find("min_image_num = 9"),
-            std::string::npos);
   EXPECT_NE(problem([](GroupingOptions& o) { o.tile_size = 0; }).find("tile_size"),
             std::string::npos);
   EXPECT_NE(problem([](GroupingOptions& o) { o.tile_size = 4.5; }).find("tile_size"),
@@ -455,7 +449,7 @@ TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {
   bad.max_images = 0;
   EXPECT_FALSE(bad.Check());
   const SimBlock s = MakeSimBlock("tiny");
-  EXPECT_THROW(PlanGroups(s.block, bad), Error);
+  EXPECT_THROW(PlanGroups(s.block, bad, MatcherOptions{}), Error);
 }
 
 TEST(GroupingOptions, StrategyNames) {
@@ -496,7 +490,7 @@ TEST(GroupingOptions, ByteSizes) {
 TEST(GroupingPlan, TooFewImages) {
   SimBlock s = MakeSimBlock("tiny");
   s.block.images.resize(1);
-  EXPECT_THROW(PlanGroups(s.block, GroupingOptions{}), Error);
+  EXPECT_THROW(PlanGroups(s.block, GroupingOptions{}, MatcherOptions{}), Error);
 }
 
 }  // namespace

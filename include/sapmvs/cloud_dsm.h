@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "sapmvs/option_spec.h"
 #include "sapmvs/ply_io.h"
 #include "sapmvs/raster_io.h"
 
@@ -23,6 +24,21 @@ struct DsmOptions {
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
 };
+
+template <class F>
+void VisitFields(DsmOptions& o, F&& f) {
+  f(Field(o.cell_size, "cell_size")
+        .Flag("--dsm-cell")
+        .In("Merge and DSM")
+        .Unit("CRS units")
+        .Range(AtLeast(0))
+        .Help("DSM cell, CRS units (0 = twice the mean point spacing)"));
+  f(Field(o.fill_passes, "fill_passes")
+        .Flag("--dsm-fill")
+        .In("Merge and DSM")
+        .Range(Between(0, 10))
+        .Help("DSM gap-filling passes"));
+}
 
 // Mean distance from a point to its nearest neighbour (3D), CRS units; over
 // at most `max_samples` points taken at an even stride (the statistic is

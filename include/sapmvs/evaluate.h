@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "sapmvs/dsm_completeness.h"
+
 namespace sapmvs {
 
 struct GeoRaster;
@@ -101,14 +103,6 @@ struct ErrorRow {
 ErrorRow ComputeErrorRow(const std::vector<double>& dz, double tolerance,
                          double threshold = std::numeric_limits<double>::infinity());
 
-// Completeness against a DSM: how much of the footprint the cloud covers.
-struct Completeness {
-  std::string footprint;  // how the footprint was chosen, for the report
-  long cells = 0;         // non-empty DSM cells in the footprint
-  long filled = 0;        // of those, cells holding a cloud point with |dz| <= tolerance
-  double share = std::numeric_limits<double>::quiet_NaN();  // filled / cells
-};
-
 struct EvaluationReport {
   std::filesystem::path cloud, reference;
   ReferenceKind kind = ReferenceKind::kLidar;
@@ -152,12 +146,6 @@ std::vector<Eigen::Vector3d> ReadCloudPositions(const std::filesystem::path& pat
 EvaluationReport EvaluateAgainstLidar(std::vector<Eigen::Vector3d> cloud,
                                       const std::vector<Eigen::Vector3d>& lidar,
                                       const EvaluateOptions& options);
-
-// DSM cells that form the footprint evaluated for completeness.
-struct DsmFootprint {
-  std::vector<uint8_t> mask;  // row-major like GeoRaster::values; 1 = inside
-  std::string note;           // how it was chosen, for the report
-};
 
 // The DSM protocol for points in memory, with completeness when `footprint`
 // is given; options.cloud / reference only label the report.

@@ -18,47 +18,12 @@
 #include <vector>
 
 #include "sapmvs/block.h"
+#include "sapmvs/grouping_options.h"
+#include "sapmvs/matcher_options.h"
 
 namespace sapmvs {
 
-struct MatcherOptions;
 struct BlockGeometry;
-
-enum class GroupingStrategy { kStrip, kFootprint };
-std::string ToString(GroupingStrategy s);
-// "strip" or "footprint"; throws sapmvs::Error naming the text and the
-// expected values otherwise.
-GroupingStrategy ParseGroupingStrategy(const std::string& text);
-
-struct GroupingOptions {
-  // The paper's; footprint becomes the default only once it is shown better.
-  GroupingStrategy strategy = GroupingStrategy::kStrip;
-  // Most images per group, >= 2.
-  int max_images = 6;
-  // Bytes that the device + host estimate of one group must fit in.
-  double memory_budget = 8.0 * (1ull << 30);
-  // Pyramid level the groups are matched at (MatcherOptions::level), 0..6;
-  // only the memory estimate depends on it.
-  int level = 1;
-  // Footprint strategy: tile side as a share of the median image footprint's
-  // shorter side on the ground, (0, 4]. Smaller tiles give more groups, each
-  // with views chosen for a smaller area.
-  double tile_size = 1.0;
-  // Footprint strategy: images are added to a tile's group until every point
-  // of the tile is seen by this many of them (or max_images is reached),
-  // >= 2.
-  int tile_views = 4;
-  // Images a patch must be photo-consistent in (MatcherOptions::min_image_num),
-  // 2..kMaxViews: a run shorter than this takes the strip images before it,
-  // and images of a group that overlap fewer than min_image_num - 1 others of
-  // it are reported, since they cannot be matched there.
-  int min_image_num = 3;
-
-  // Logs the first failing condition to stderr and returns false.
-  bool Check() const;
-  // "" or the first failing condition as "what was expected (name = value)".
-  std::string Problem() const;
-};
 
 struct GroupMemory {
   double device_bytes = 0;
@@ -116,7 +81,10 @@ struct ImageGroup {
 
 struct GroupingPlan {
   GroupingStrategy strategy = GroupingStrategy::kStrip;
-  GroupingOptions options;               // what the plan was made with
+  GroupingOptions options;  // what the plan was made with
+  // The matcher it was made for: its level, cell size and wave size (the
+  // memory estimate) and min_image_num (short runs, short_of_views).
+  MatcherOptions matcher;
   std::vector<std::vector<int>> strips;  // detected strips, images in flight order
   std::vector<ImageGroup> groups;
   std::vector<int> ungrouped;  // images in no group (see PlanGroups)
@@ -134,10 +102,15 @@ struct GroupingPlan {
 // convergent) is cut in block order as one strip, its groups with strip -1. Footprint strategy:
 // images without a surface estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error
 // for bad options, a block of fewer than 2 images, and when 2 images do not fit memory_budget.
+// `matcher`: the options the groups will be matched with. Its level, cell
+// size and wave size set the memory estimate; a strip run shorter than its
+// min_image_num takes the strip images before it, and images of a group that
+// overlap fewer than min_image_num - 1 others of it are reported
+// (short_of_views), since they cannot be matched there.
 // `geometry`: EstimateBlockGeometry(block) when the caller has it (it reads
 // the block's DEM), else nullptr and it is estimated here.
 GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
-                        const BlockGeometry* geometry = nullptr);
+                        const MatcherOptions& matcher, const BlockGeometry* geometry = nullptr);
 
 // Like the paper's Table 3: group, image numbers (1-based), image names,
 // number of images, and the memory estimate of each group.

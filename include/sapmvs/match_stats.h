@@ -1,0 +1,59 @@
+#pragma once
+// What matching one group did and how long it took: counts, per-stage and
+// per-kernel times. The matcher fills them; the run sums, reports and
+// checkpoints them.
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sapmvs {
+
+// Wall and device time of one stage, seconds.
+struct StageTime {
+  double wall = 0;
+  double device = 0;
+  double peak_rss_bytes = 0;  // the process's peak so far, at the stage's end
+};
+
+struct KernelTime {
+  long launches = 0;
+  long items = 0;  // work items: patches (refinement) or (patch, view) pairs (scoring)
+  // NCC evaluations of one patch in one view pair, each over patch_size^2
+  // samples: one per pair for scoring; for refinement the upper bound
+  // sum over patches of views * (1 + 6 * rounds), rounds = min(iterations,
+  // moves + max_halvings) (a candidate that
+  // leaves the image stops early).
+  double ncc_evaluations = 0;
+  int patch_size = 0;
+  double seconds = 0;      // device time, summed (0 without queue profiling)
+  double max_seconds = 0;  // of one launch
+};
+
+struct MatchStats {
+  int images = 0;
+  long features = 0;
+  long seeds_tried = 0;
+  long seeds_accepted = 0;
+  long edge_points = 0;
+  long matched_edge_points = 0;
+  long candidates = 0;  // patches refined during propagation
+  long patches = 0;     // accepted (seeds + propagation)
+  long waves = 0;
+  long largest_wave = 0;
+  std::map<int, long> accepted_by_size;  // sapmvs: patch side -> accepted patches
+  long points_before_filter = 0;
+  double score_floor = 0;      // the score fence's value (>= threshold)
+  double plane_tolerance = 0;  // the neighbourhood test's, footprints (last pass)
+  long removed_score = 0;      // below score_floor
+  long removed_visibility = 0;
+  long removed_neighbourhood = 0;
+  long removed_clusters = 0;
+  long removed_depth_range = 0;  // far outside the depths the image's seeds span
+  long points = 0;
+  std::vector<std::pair<std::string, StageTime>> stages;  // in order
+  std::map<std::string, KernelTime> kernels;
+  double gsd = 0;  // median footprint of a pixel at the working level, block units
+};
+
+}  // namespace sapmvs
