@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
-# Installs, builds and runs the whole test suite (GoogleTest through CTest;
-# OpenCL kernels run on the PoCL CPU device).
+# Installs, builds and runs the test suite (GoogleTest through CTest; OpenCL
+# kernels run on the PoCL CPU device).
 #
-#   scripts/test.sh [ctest args...]              the full suite, in build/
+#   scripts/test.sh [ctest args...]              the whole suite, in build/
+#   scripts/test.sh --opencl [ctest args...]     only the tests that need an
+#       OpenCL device (label `opencl`), in build/; CI runs this and then
+#       --sanitize, which runs the others
 #   scripts/test.sh --sanitize [ctest args...]   AddressSanitizer + UBSan build
 #       in build-sanitize/ (gcc, -O1) of the tests that need no OpenCL device
 #       (label `host`, see tests/CMakeLists.txt); any report fails its test.
+#
+# Labels: host/opencl (needs a device or not), fast/e2e (e.g. `-L fast`).
+# The suite needs an OpenCL device: without one, test.sh stops at once, and a
+# device test fails rather than skips (SAPMVS_REQUIRE_OPENCL=1). Without a
+# driver, run the host tests: SAPMVS_REQUIRE_OPENCL=0 scripts/test.sh -L host.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -36,5 +44,27 @@ if [ "${1:-}" = "--sanitize" ]; then
   echo "test.sh --sanitize: build $((built - start)) s, tests $(($(date +%s) - built)) s"
   exit 0
 fi
-bash scripts/build.sh
-ctest --test-dir build --output-on-failure -j"$jobs" "$@"
+
+targets=(sapmvs sapmvs_opencl_tests sapmvs_tests)
+labels=()
+if [ "${1:-}" = "--opencl" ]; then
+  shift
+  targets=(sapmvs sapmvs_opencl_tests)
+  labels=(-L opencl)
+fi
+bash scripts/install-deps.sh
+if [ ! -f build/CMakeCache.txt ]; then
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
+# Only what the tests run (scripts/build.sh builds the profiling tools too).
+start=$(date +%s)
+cmake --build build --target "${targets[@]}" -j"$jobs"
+built=$(date +%s)
+export SAPMVS_REQUIRE_OPENCL="${SAPMVS_REQUIRE_OPENCL:-1}"
+if [ "$SAPMVS_REQUIRE_OPENCL" = "1" ] && ! ./build/sapmvs devices >/dev/null 2>&1; then
+  echo "test.sh: no OpenCL device found ($(./build/sapmvs devices 2>&1 | head -1));" \
+    "without one, run the host tests: SAPMVS_REQUIRE_OPENCL=0 bash scripts/test.sh -L host" >&2
+  exit 1
+fi
+ctest --test-dir build --output-on-failure -j"$jobs" "${labels[@]}" "$@"
+echo "test.sh: build $((built - start)) s, tests $(($(date +%s) - built)) s"

@@ -183,7 +183,7 @@ std::vector<DeviceInfo> ListDevicesOrSkip(bool* skip) {
 TEST(ClDevicesTest, ListingFindsPoclCpuDevice) {
   bool skip = false;
   const std::vector<DeviceInfo> devices = ListDevicesOrSkip(&skip);
-  if (skip) GTEST_SKIP() << "no OpenCL platform installed";
+  if (skip) SAPMVS_SKIP_WITHOUT_OPENCL("no OpenCL platform installed");
   int pocl = -1;
   for (size_t i = 0; i < devices.size(); ++i) {
     const DeviceInfo& device = devices[i];

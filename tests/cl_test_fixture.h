@@ -2,7 +2,8 @@
 // Shared fixture for tests that need an OpenCL device. The device comes from
 // SAPMVS_TEST_DEVICE, else SAPMVS_DEVICE, else the PoCL CPU device (the
 // reference device, so results do not depend on which GPU a machine has), else
-// the default device. Without any OpenCL device the tests skip with the reason;
+// the default device. Without any OpenCL device the tests skip with the reason
+// (fail with SAPMVS_REQUIRE_OPENCL=1);
 // a spec that matches nothing fails, since that is a misconfiguration.
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <string>
 
 #include "cl_runtime.h"
+#include "test_util.h"
 
 namespace sapmvs::test {
 
@@ -71,7 +73,7 @@ class ClTest : public ::testing::Test {
 
   void SetUp() override {
     const Shared& shared = GetShared();
-    if (shared.skip) GTEST_SKIP() << shared.reason;
+    if (shared.skip) SAPMVS_SKIP_WITHOUT_OPENCL(shared.reason);
     ASSERT_TRUE(shared.context) << shared.reason;
   }
 

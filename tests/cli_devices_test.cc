@@ -10,11 +10,10 @@
 namespace sapmvs {
 namespace {
 
-using test::HaveOpenClDevice;
 using test::RunCli;
 
 TEST(CliDevices, ListsDevicesAndMarksTheDefault) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli("devices", "env -u SAPMVS_DEVICE");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("compute units"), std::string::npos) << r.out;
@@ -25,7 +24,7 @@ TEST(CliDevices, ListsDevicesAndMarksTheDefault) {
 }
 
 TEST(CliDevices, ChoosesByIndexFlagOrEnvironment) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto flag = RunCli("devices --device 0");
   ASSERT_EQ(flag.exit_code, 0) << flag.err;
   EXPECT_NE(flag.out.find("\n*  0 "), std::string::npos) << flag.out;
@@ -36,7 +35,7 @@ TEST(CliDevices, ChoosesByIndexFlagOrEnvironment) {
 }
 
 TEST(CliDevices, UnmatchedDeviceIsOneLineAndExitCode2) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli("devices --device no-such-device-anywhere");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(test::CountLines(r.err), 1) << r.err;

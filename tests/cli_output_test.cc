@@ -23,7 +23,6 @@ namespace sapmvs {
 namespace {
 
 namespace fs = std::filesystem;
-using test::HaveOpenClDevice;
 using test::RunCli;
 
 bool HavePrlimit() { return std::system("prlimit --version >/dev/null 2>&1") == 0; }
@@ -153,7 +152,7 @@ TEST_F(CliOutputTest, RunOnABusyFolderIsRefusedNamingThePid) {
 // A failed start writes nothing, so the corrected command is not refused
 // (before, groups/plan.json stayed and asked for --restart).
 TEST_F(CliOutputTest, BadDeviceLeavesNothingBehind) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli(Run(Block(), out_, "--device 99"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err.rfind("sapmvs: OpenCL device index 99 (from --device) is out of range; "
@@ -209,7 +208,7 @@ TEST_F(CliOutputTest, MissingProfileFolderIsRefusedBeforeAnyWork) {
 // plan kept whole, no empty or cut file; a temporary file of a run killed
 // meanwhile is cleaned up by the resume, which needs no --restart.
 TEST_F(CliOutputTest, FullDiskAtACheckpointKeepsThePlanAndResumes) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli(Run(Block(), out_), FullDiskUnder(out_, 4096));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(r.err, "sapmvs: " + (out_ / "groups" / "group_001.ply").string() +
@@ -237,9 +236,10 @@ TEST_F(CliOutputTest, FullDiskAtACheckpointKeepsThePlanAndResumes) {
 // matches nothing again and writes the bytes an undisturbed run writes; then
 // --restart deletes what sapmvs wrote and nothing else.
 TEST_F(CliOutputTest, FullDiskAtTheCloudKeepsTheGroupsAndResumesToTheSameBytes) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
-  const fs::path whole = out_ / "whole", cut = out_ / "cut";
-  const auto a = RunCli(Run(Block(), whole));
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const fs::path cut = out_ / "cut";
+  // Undisturbed: the run of Run(), shared (read only).
+  const auto [whole, a] = test::SharedRun(Block(), "--min-image-num 2 --max-images 3 -q");
   ASSERT_EQ(a.exit_code, 0) << a.err;
   const uintmax_t group_max = std::max(fs::file_size(whole / "groups" / "group_001.ply"),
                                        fs::file_size(whole / "groups" / "group_002.ply"));

@@ -1,15 +1,16 @@
 // What `sapmvs run` writes, read back by the tools users open it with:
 // cloud.las by @loaders.gl/las and copc.js (node, from npm) and by our own
 // reader, in both LAS versions; the DSM's pictures by GDAL and OpenCV. One run
-// per LAS version for the whole suite.
+// per LAS version for the whole suite (test::SharedRun; the LAS 1.2 one is
+// also CliRunTest's).
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -20,54 +21,32 @@
 #include "sapmvs/cloud_las.h"
 #include "sapmvs/las_io.h"
 #include "sapmvs/ply_io.h"
-#include "sapmvs/simulate.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
 
 namespace fs = std::filesystem;
-using test::HaveOpenClDevice;
-using test::RunCli;
 
 class CliRunOutputsTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("sapmvs_cli_run_outputs_test_" + std::to_string(::getpid())));
-    fs::remove_all(*root_);
-    if (!HaveOpenClDevice()) return;
-    SimulateOptions o;
-    o.preset = "tiny";
-    o.out = *root_ / "tiny";
-    o.seed = 1;
-    o.quiet = true;
-    Simulate(o);
-    const std::string block = (o.out / "block.yaml").string();
-    run12_ = RunCli("run " + block + " --out " + Out("1.2").string() + " -q").exit_code;
-    run14_ = RunCli("run " + block + " --out " + Out("1.4").string() + " -q --las-version 1.4")
-                 .exit_code;
-  }
-  static void TearDownTestSuite() {
-    std::error_code ec;
-    fs::remove_all(*root_, ec);
-    delete root_;
-    root_ = nullptr;
-  }
   void SetUp() override {
-    if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
-    ASSERT_EQ(run12_, 0) << "sapmvs run (LAS 1.2) failed";
-    ASSERT_EQ(run14_, 0) << "sapmvs run --las-version 1.4 failed";
+    SAPMVS_REQUIRE_OPENCL_DEVICE();
+    const fs::path block = test::Simulated("tiny", 1) / "block.yaml";
+    for (const std::string version : {"1.2", "1.4"}) {
+      const auto [out, r] =
+          test::SharedRun(block, version == "1.2" ? "-q" : "-q --las-version " + version);
+      ASSERT_EQ(r.exit_code, 0) << "sapmvs run (LAS " << version << ") failed: " << r.err;
+      out_[version] = out;
+    }
   }
 
-  static fs::path Out(const std::string& version) { return *root_ / ("run" + version); }
+  // The run's folder (read only) for LAS `version`.
+  fs::path Out(const std::string& version) const { return out_.at(version); }
 
-  static fs::path* root_;
-  static int run12_, run14_;
+ private:
+  std::map<std::string, fs::path> out_;
 };
-
-fs::path* CliRunOutputsTest::root_ = nullptr;
-int CliRunOutputsTest::run12_ = -1;
-int CliRunOutputsTest::run14_ = -1;
 
 // Where scripts/install-deps.sh puts the npm readers; "" when absent.
 std::string NpmDirWithLasReaders() {
@@ -86,7 +65,7 @@ std::string NpmDirWithLasReaders() {
 
 // tests/las_check.cjs's JSON for `las`, every `stride`-th point.
 nlohmann::json ReadWithNode(const std::string& npm, const fs::path& las, int stride) {
-  const fs::path json = las.parent_path() / (las.stem().string() + "_node.json");
+  const fs::path json = test::ScratchDir() / (las.stem().string() + "_node.json");
   const std::string cmd = "node " + (fs::path(SAPMVS_TEST_DIR) / "las_check.cjs").string() + " " +
                           npm + " " + las.string() + " " + std::to_string(stride) + " > " +
                           json.string();

@@ -49,6 +49,9 @@ class CliRunTest : public ::testing::Test {
   }
 
   static fs::path Block() { return test::Simulated("tiny", 1) / "block.yaml"; }
+  // For the flags refused before the block is read: no block to simulate,
+  // and a run that read it first would fail naming it instead.
+  static fs::path NoBlock() { return *root_ / "no_block" / "block.yaml"; }
   // Nothing at all under the output folder (or no folder).
   bool NoOutput() const { return !fs::exists(out_) || fs::is_empty(out_); }
 
@@ -141,13 +144,13 @@ void ExpectRunProvenance(const nlohmann::json& j, const PointCloud& cloud) {
 }
 
 TEST_F(CliRunTest, WritesCloudAndReport) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
-  const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " -q");
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const auto [out, r] = test::SharedRun(Block(), "-q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_NE(r.out.find("cloud.ply"), std::string::npos) << r.out;
 
-  const PointCloud cloud = ReadPly(out_ / "cloud.ply");
+  const PointCloud cloud = ReadPly(out / "cloud.ply");
   ASSERT_GT(cloud.points.size(), 0u);
   EXPECT_TRUE(cloud.has_normals);
   EXPECT_TRUE(cloud.has_colors);
@@ -158,7 +161,7 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
   // Default min_image_num is 3.
   for (const CloudPoint& p : cloud.points) ASSERT_GE(p.num_views, 3);
 
-  std::ifstream in(out_ / "report.json");
+  std::ifstream in(out / "report.json");
   ASSERT_TRUE(in) << "no report.json";
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j.at("points").get<long>(), static_cast<long>(cloud.points.size()));
@@ -166,7 +169,7 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
   EXPECT_EQ(j.at("level"), 1);
   EXPECT_EQ(j.at("images"), 4);
   // `plan` with the same flags shows the groups the run matched.
-  const fs::path plan_json = out_.string() + "_plan.json";  // not among the run's files
+  const fs::path plan_json = *root_ / "plan.json";  // not among the run's files
   const auto plan = RunCli("plan " + Block().string() + " --json " + plan_json.string());
   ASSERT_EQ(plan.exit_code, 0) << plan.err;
   std::ifstream plan_in(plan_json);
@@ -194,8 +197,8 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
 
   // The outputs and one group's checkpoint, no temporary file left behind.
   std::set<std::string> files;
-  for (const auto& e : fs::recursive_directory_iterator(out_)) {
-    if (e.is_regular_file()) files.insert(fs::relative(e.path(), out_).string());
+  for (const auto& e : fs::recursive_directory_iterator(out)) {
+    if (e.is_regular_file()) files.insert(fs::relative(e.path(), out).string());
   }
   const std::set<std::string> expected = {".sapmvs_run",  // the folder's marker and lock
                                           "cloud.ply",
@@ -219,7 +222,7 @@ TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {
   const auto info = RunCli("info " + odm.string() + " --ground-height 98");
   ASSERT_EQ(info.exit_code, 0) << info.err;
   EXPECT_NE(info.out.find("frame          CRS EPSG:32651 ("), std::string::npos) << info.out;
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli("run " + odm.string() + " --ground-height 98 --level 2 --out " +
                         out_.string() + " -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -231,7 +234,7 @@ TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {
 }
 
 TEST_F(CliRunTest, MinImageNumTwoIsAccepted) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r =
       RunCli("run " + Block().string() + " --out " + out_.string() + " --min-image-num 2 -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -260,7 +263,7 @@ TEST_F(CliRunTest, MissingBlockIsOneLineNamingThePath) {
 }
 
 TEST_F(CliRunTest, UnknownModeIsOneLineNamingIt) {
-  const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " --mode foo");
+  const auto r = RunCli("run " + NoBlock().string() + " --out " + out_.string() + " --mode foo");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("'foo'"), std::string::npos) << r.err;
@@ -268,7 +271,7 @@ TEST_F(CliRunTest, UnknownModeIsOneLineNamingIt) {
 }
 
 TEST_F(CliRunTest, NegativeLevelIsOneLineNamingIt) {
-  const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " --level -1");
+  const auto r = RunCli("run " + NoBlock().string() + " --out " + out_.string() + " --level -1");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("level"), std::string::npos) << r.err;
@@ -289,17 +292,18 @@ TEST_F(CliRunTest, TakesInfosBlockFlags) {
   EXPECT_EQ(test::CountLines(no_images.err), 1) << no_images.err;
   EXPECT_NE(no_images.err.find(empty.string()), std::string::npos) << no_images.err;
   EXPECT_TRUE(NoOutput());
-  const auto bad_format = RunCli(run + " --format bogus");
+  const std::string no_block = "run " + NoBlock().string() + " --out " + out_.string();
+  const auto bad_format = RunCli(no_block + " --format bogus");
   EXPECT_NE(bad_format.exit_code, 0);
   EXPECT_EQ(test::CountLines(bad_format.err), 1) << bad_format.err;
   EXPECT_NE(bad_format.err.find("bogus"), std::string::npos) << bad_format.err;
   EXPECT_TRUE(NoOutput());
-  const auto bad_height = RunCli(run + " --ground-height inf");
+  const auto bad_height = RunCli(no_block + " --ground-height inf");
   EXPECT_NE(bad_height.exit_code, 0);
   EXPECT_EQ(test::CountLines(bad_height.err), 1) << bad_height.err;
   EXPECT_NE(bad_height.err.find("ground height"), std::string::npos) << bad_height.err;
   EXPECT_TRUE(NoOutput());
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli(run + " --format yaml --image-dir " +
                         (Block().parent_path() / "images").string() + " --no-size-check -q");
   EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -307,7 +311,7 @@ TEST_F(CliRunTest, TakesInfosBlockFlags) {
 }
 
 TEST_F(CliRunTest, ProfilePrintsKernelTablesAndWritesThem) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli("run " + Block().string() + " --out " + out_.string() + " --profile -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("profile: kernels"), std::string::npos) << r.out;
@@ -344,10 +348,12 @@ TEST_F(CliRunTest, ProfilePrintsKernelTablesAndWritesThem) {
 // group per strip by --max-images 3, matched with min_image_num 2.
 class CliBlockRunTest : public CliRunTest {
  protected:
+  static constexpr const char* kArgs = "--min-image-num 2 --max-images 3 -q";
   static std::string Args(const fs::path& out, const std::string& more = "") {
-    return "run " + Block().string() + " --out " + out.string() +
-           " --min-image-num 2 --max-images 3 -q " + more;
+    return "run " + Block().string() + " --out " + out.string() + " " + kArgs + " " + more;
   }
+  // The run of Args(), shared by the tests that only read it.
+  static test::SharedRunResult Shared() { return test::SharedRun(Block(), kArgs); }
   static std::string Bytes(const fs::path& path) {
     std::ifstream f(path, std::ios::binary);
     std::ostringstream s;
@@ -361,9 +367,9 @@ class CliBlockRunTest : public CliRunTest {
 };
 
 TEST_F(CliBlockRunTest, ResumedRunWritesTheSameCloud) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
-  const fs::path whole = out_ / "whole", parts = out_ / "parts";
-  const auto a = RunCli(Args(whole));
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const auto [whole, a] = Shared();
+  const fs::path parts = out_ / "parts";
   ASSERT_EQ(a.exit_code, 0) << a.err;
   const nlohmann::json ja = Report(whole);
   ASSERT_EQ(ja.at("groups").size(), 2u) << ja.at("groups");
@@ -399,11 +405,11 @@ TEST_F(CliBlockRunTest, ResumedRunWritesTheSameCloud) {
 }
 
 TEST_F(CliBlockRunTest, MergedCloudHasNoCrossGroupDuplicates) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
-  const auto r = RunCli(Args(out_));
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const auto [out, r] = Shared();
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const nlohmann::json j = Report(out_);
-  const PointCloud cloud = ReadPly(out_ / "cloud.ply");
+  const nlohmann::json j = Report(out);
+  const PointCloud cloud = ReadPly(out / "cloud.ply");
   // The merged file lists each group's kept points in group order.
   std::vector<int> group_of;
   long input = 0;
@@ -429,22 +435,23 @@ TEST_F(CliBlockRunTest, MergedCloudHasNoCrossGroupDuplicates) {
 }
 
 TEST_F(CliBlockRunTest, DsmIsReadByGdalinfoWithTheBlocksCrsAndTheCloudsExtent) {
-  if (!HaveOpenClDevice()) GTEST_SKIP() << "no OpenCL device on this machine";
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
   if (std::system("gdalinfo --version >/dev/null 2>&1") != 0) {
     GTEST_SKIP() << "gdalinfo missing (Debian package gdal-bin)";
   }
-  const auto r = RunCli(Args(out_));
+  const auto [out, r] = Shared();
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const fs::path json = out_ / "gdalinfo.json";
+  fs::create_directories(out_);
+  const fs::path json = out_ / "gdalinfo.json";  // beside, not in, the shared run
   const std::string cmd =
-      "gdalinfo -json " + (out_ / "dsm.tif").string() + " > " + json.string() + " 2>/dev/null";
+      "gdalinfo -json " + (out / "dsm.tif").string() + " > " + json.string() + " 2>/dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j.at("driverShortName"), "GTiff");
   const std::string wkt = j.at("coordinateSystem").at("wkt").get<std::string>();
   EXPECT_NE(wkt.find("32632"), std::string::npos) << wkt;  // the tiny block's UTM 32N
-  const PointCloud cloud = ReadPly(out_ / "cloud.ply");
+  const PointCloud cloud = ReadPly(out / "cloud.ply");
   double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300;
   for (const CloudPoint& p : cloud.points) {
     xmin = std::min(xmin, p.position.x());
@@ -465,7 +472,7 @@ TEST_F(CliBlockRunTest, DsmIsReadByGdalinfoWithTheBlocksCrsAndTheCloudsExtent) {
   EXPECT_LE(lry, ymin);
   EXPECT_GT(lry, ymin - cell - 1e-9);
   // The cell defaults to twice the mean point spacing, as the report says.
-  EXPECT_NEAR(cell, Report(out_).at("dsm_cell").get<double>(), 1e-9);
+  EXPECT_NEAR(cell, Report(out).at("dsm_cell").get<double>(), 1e-9);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "cl_runtime.h"
 #include "sapmvs/error.h"
+#include "test_util.h"
 
 namespace sapmvs::test {
 
@@ -36,6 +37,25 @@ CliResult RunCli(const std::string& args, const std::string& env) {
   r.err = slurp(dir / "err.txt");
   std::filesystem::remove_all(dir);
   return r;
+}
+
+SharedRunResult SharedRun(const std::filesystem::path& block, const std::string& args) {
+  const std::string id =
+      "run_" + std::to_string(std::hash<std::string>{}(block.string() + " " + args));
+  const std::filesystem::path dir = SharedFolder(id, [&](const std::filesystem::path& d) {
+    std::filesystem::create_directories(d);
+    const CliResult r =
+        RunCli("run " + block.string() + " --out " + (d / "out").string() + " " + args);
+    std::ofstream(d / "exit_code") << r.exit_code;
+    std::ofstream(d / "stdout", std::ios::binary) << r.out;
+    std::ofstream(d / "stderr", std::ios::binary) << r.err;
+  });
+  SharedRunResult s;
+  s.out = dir / "out";
+  std::ifstream(dir / "exit_code") >> s.result.exit_code;
+  s.result.out = Slurp(dir / "stdout");
+  s.result.err = Slurp(dir / "stderr");
+  return s;
 }
 
 int CountLines(const std::string& text) {

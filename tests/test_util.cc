@@ -28,19 +28,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// This test binary's identity (size and modification time): a cache made by
-// another build may hold another simulator's images.
-std::string BinaryKey() {
+// This build's identity: the sapmvs binary's path, size and modification
+// time. Both test binaries and the CLI link the same sapmvs_core, which is
+// relinked into sapmvs whenever it changes; a cache made by another build may
+// hold another simulator's images or another matcher's cloud.
+std::string BuildKey() {
   std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return "pid" + std::to_string(::getpid());
+  const fs::path exe = SAPMVS_CLI_PATH;
   const auto size = fs::file_size(exe, ec);
   const auto time = fs::last_write_time(exe, ec).time_since_epoch().count();
   return std::to_string(std::hash<std::string>{}(exe.string())) + "_" + std::to_string(size) + "_" +
          std::to_string(time);
 }
 
-// Drops the caches of other builds of this binary left an hour or more ago.
+// Drops the caches of other builds left an hour or more ago.
 void RemoveStaleCaches(const fs::path& keep) {
   std::error_code ec;
   const auto now = fs::file_time_type::clock::now();
@@ -55,30 +56,21 @@ void RemoveStaleCaches(const fs::path& keep) {
 
 }  // namespace
 
-fs::path Simulated(const std::string& preset, int seed, double scale) {
+fs::path SharedFolder(const std::string& id, const std::function<void(const fs::path&)>& make) {
   static std::map<std::string, fs::path> made;
-  std::ostringstream id;
-  id << preset << "_seed" << seed << "_scale" << scale;
-  if (auto it = made.find(id.str()); it != made.end()) return it->second;
-  const fs::path cache = fs::temp_directory_path() / ("sapmvs_sim_cache_" + BinaryKey());
+  if (auto it = made.find(id); it != made.end()) return it->second;
+  const fs::path cache = fs::temp_directory_path() / ("sapmvs_sim_cache_" + BuildKey());
   fs::create_directories(cache);
-  const fs::path dir = cache / id.str();
-  // One process simulates; the others of a parallel ctest wait for it.
-  const int lock = ::open((cache / (id.str() + ".lock")).c_str(), O_CREAT | O_RDWR, 0644);
+  const fs::path dir = cache / id;
+  // Made in place (a run's files name their folder) and marked done beside it.
+  const fs::path done = cache / (id + ".done");
+  const int lock = ::open((cache / (id + ".lock")).c_str(), O_CREAT | O_RDWR, 0644);
   if (lock < 0 || ::flock(lock, LOCK_EX) != 0) throw Error("cannot lock " + cache.string());
   try {
-    if (!fs::exists(dir / "block.yaml")) {
-      const fs::path tmp = cache / (id.str() + ".tmp." + std::to_string(::getpid()));
-      fs::remove_all(tmp);
-      SimulateOptions o;
-      o.preset = preset;
-      o.out = tmp;
-      o.seed = seed;
-      o.scale = scale;
-      o.quiet = true;
-      Simulate(o);
+    if (!fs::exists(done)) {
       fs::remove_all(dir);
-      fs::rename(tmp, dir);  // complete or absent
+      make(dir);
+      std::ofstream(done).put('\n');
       RemoveStaleCaches(cache);
     }
   } catch (...) {
@@ -86,8 +78,27 @@ fs::path Simulated(const std::string& preset, int seed, double scale) {
     throw;
   }
   ::close(lock);
-  made[id.str()] = dir;
+  made[id] = dir;
   return dir;
+}
+
+fs::path Simulated(const std::string& preset, int seed, double scale) {
+  std::ostringstream id;
+  id << preset << "_seed" << seed << "_scale" << scale;
+  return SharedFolder(id.str(), [&](const fs::path& dir) {
+    SimulateOptions o;
+    o.preset = preset;
+    o.out = dir;
+    o.seed = seed;
+    o.scale = scale;
+    o.quiet = true;
+    Simulate(o);
+  });
+}
+
+bool OpenClRequired() {
+  const char* env = std::getenv("SAPMVS_REQUIRE_OPENCL");
+  return env && std::string(env) == "1";
 }
 
 std::string Slurp(const std::filesystem::path& path) {

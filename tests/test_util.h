@@ -24,11 +24,17 @@ std::string Slurp(const std::filesystem::path& path);
 // A fresh, empty directory under the system temp dir, unique per test.
 std::filesystem::path ScratchDir();
 
-// The simulator's `preset` rendered with `seed` at `scale`, simulated once
-// for every test process of this build (under a lock, into a cache in the
-// temp folder keyed by the test binary) instead of once per process: ctest
-// runs each test in its own process, and the CLI suites simulated tiny in
-// every one. Read only: a test that needs a changed block copies it.
+// A folder that `make` fills once for every test process of this build and
+// that the tests then only read: ctest runs each test in its own process, so
+// a per-process cache would remake it for every test. Kept in the temp folder
+// under a lock (the other processes of a parallel ctest wait), keyed by `id`
+// and by this build's sapmvs binary; a folder whose `make` did not finish is
+// made again.
+std::filesystem::path SharedFolder(const std::string& id,
+                                   const std::function<void(const std::filesystem::path&)>& make);
+
+// The simulator's `preset` rendered with `seed` at `scale` (a SharedFolder).
+// Read only: a test that needs a changed block copies it.
 std::filesystem::path Simulated(const std::string& preset, int seed, double scale = 1.0);
 
 // Kernel-versus-reference comparison: |actual - expected| <= abs_tol + rel_tol
@@ -106,6 +112,21 @@ const std::vector<Match>& SiftMatches(const std::filesystem::path& a,
 double MedianEpipolarDistance(const Camera& a, const Camera& b, const std::vector<Match>& matches);
 
 }  // namespace sapmvs::test
+
+namespace sapmvs::test {
+// Whether SAPMVS_REQUIRE_OPENCL=1 (scripts/test.sh sets it): then a test that
+// needs an OpenCL device fails without one instead of skipping, so that a
+// machine without a driver cannot pass the suite.
+bool OpenClRequired();
+}  // namespace sapmvs::test
+
+// Skips the current test for want of an OpenCL device, saying `why`; fails
+// it instead when OpenClRequired().
+#define SAPMVS_SKIP_WITHOUT_OPENCL(why)                                                    \
+  do {                                                                                     \
+    if (::sapmvs::test::OpenClRequired()) FAIL() << (why) << " (SAPMVS_REQUIRE_OPENCL=1)"; \
+    GTEST_SKIP() << (why);                                                                 \
+  } while (0)
 
 // Skips the current test, naming the missing path, when `path` does not exist.
 #define SAPMVS_REQUIRE_PATH(path)                                 \
