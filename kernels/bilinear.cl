@@ -2,7 +2,7 @@
 // image: bilinear_sample.cl (which states the border policy and has the
 // double-precision twin) and, through ncc.cl, the NCC kernels. Programs get
 // it by `#include "bilinear.cl"`, which the host expands when it builds them
-// (host/kernel_source.h, ProgramSource); the guard keeps one definition when
+// (host/device/kernel_source.h, ProgramSource); the guard keeps one definition when
 // a program reaches it twice.
 
 #ifndef SAPMVS_BILINEAR_CL

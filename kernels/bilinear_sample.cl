@@ -1,6 +1,6 @@
 // Bilinear interpolation of a single-channel float image at a batch of
 // sub-pixel positions; the sampling primitive of the NCC kernels. See
-// kernels/README.md. BilinearSampleReference (host/bilinear_sampler.cc) is the
+// kernels/README.md. BilinearSampleReference (host/device/bilinear_sampler.cc) is the
 // double-precision twin and must keep exactly the same border policy:
 //
 // - Pixel (0, 0) is the centre of the top-left pixel (OpenCV convention), so

@@ -1,9 +1,9 @@
 // The NCC primitives shared by ncc_score.cl, patch_refine.cl and
 // roofline_probe.cl, so that the three score exactly the same arithmetic:
 // the camera and patch structs, projection and sampling, the weighted NCC
-// and its sample weights. NccScoreReference (host/ncc_scorer.cc) is the
+// and its sample weights. NccScoreReference (host/device/ncc_scorer.cc) is the
 // double-precision twin. Programs get it by `#include "ncc.cl"`, which the
-// host expands when it builds them (host/kernel_source.h, ProgramSource).
+// host expands when it builds them (host/device/kernel_source.h, ProgramSource).
 //
 // Build options it reads (the host passes all of them; see
 // sapmvs/kernel_limits.h):

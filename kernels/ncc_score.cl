@@ -1,7 +1,7 @@
 // Batched NCC scoring of PMVS patches (method.md 3.1): one work-item per
 // (patch, view) pair. See kernels/README.md for the data layout; the structs
-// and NCC primitives are in ncc.cl, their host mirrors in host/ncc_scorer.h
-// (with static_asserts on their layout), and NccScoreReference (host/ncc_scorer.cc) is the
+// and NCC primitives are in ncc.cl, their host mirrors in host/device/ncc_scorer.h
+// (with static_asserts on their layout), and NccScoreReference (host/device/ncc_scorer.cc) is the
 // double-precision twin that must keep exactly the same geometry and NaN rules.
 //
 // All coordinates are local (relative to the block's origin), in float32.

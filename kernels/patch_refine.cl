@@ -2,7 +2,7 @@
 // optimises the patch's depth along its reference ray and the two angles of
 // its normal to maximise the mean NCC over its views, all iterations
 // in-kernel. See kernels/README.md ("patch_refine.cl") for the data layout and
-// the search; PatchRefineReference (host/patch_refiner.cc) is the
+// the search; PatchRefineReference (host/device/patch_refiner.cc) is the
 // double-precision twin and must keep exactly the same parameterisation, step
 // schedule and tie rules.
 //

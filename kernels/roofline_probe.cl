@@ -10,7 +10,7 @@
 //                of this shape can reach here.
 //
 // ncc_window's result follows ncc_score's policy (RooflineProbe's reference,
-// host/roofline_probe.cc, is its double twin): a window not wholly inside
+// host/device/roofline_probe.cc, is its double twin): a window not wholly inside
 // its image gives NaN; so does a window whose variance sum is below
 // NCC_MIN_VARIANCE * mu^2; else the NCC clamped to [-1, 1].
 //

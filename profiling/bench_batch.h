@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "ncc_scorer.h"
+#include "device/ncc_scorer.h"
 
 namespace sapmvs {
 namespace {

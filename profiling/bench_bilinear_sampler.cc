@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "bench_context.h"
-#include "bilinear_sampler.h"
-#include "cl_runtime.h"
+#include "device/bilinear_sampler.h"
+#include "device/cl_runtime.h"
 
 namespace sapmvs {
 namespace {

@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "cl_runtime.h"
+#include "device/cl_runtime.h"
 
 namespace sapmvs::bench {
 

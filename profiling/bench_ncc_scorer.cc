@@ -24,9 +24,9 @@
 
 #include "bench_batch.h"
 #include "bench_context.h"
-#include "cl_runtime.h"
-#include "ncc_scorer.h"
-#include "roofline_probe.h"
+#include "device/cl_runtime.h"
+#include "device/ncc_scorer.h"
+#include "device/roofline_probe.h"
 
 namespace sapmvs {
 namespace {

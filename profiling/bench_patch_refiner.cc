@@ -13,7 +13,7 @@
 
 #include "bench_batch.h"
 #include "bench_context.h"
-#include "patch_refiner.h"
+#include "device/patch_refiner.h"
 
 namespace sapmvs {
 namespace {

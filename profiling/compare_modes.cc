@@ -12,16 +12,16 @@
 #include <iomanip>
 #include <iostream>
 
-#include "make_patch_kernels.h"
-#include "option_flags.h"
-#include "patch_kernels.h"
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/matcher.h"
-#include "sapmvs/raster_io.h"
-#include "sapmvs/surface_check.h"
+#include "device/make_patch_kernels.h"
+#include "match/patch_kernels.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/evaluate/surface_check.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/match/match_group.h"
+#include "sapmvs/util/error.h"
 #include "truth_check.h"
+#include "util/option_flags.h"
 
 using namespace sapmvs;
 

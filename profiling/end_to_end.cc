@@ -19,17 +19,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "option_flags.h"
-#include "run_profile.h"
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/dense_run.h"
-#include "sapmvs/error.h"
-#include "sapmvs/ply_io.h"
-#include "sapmvs/raster_io.h"
-#include "sapmvs/simulate.h"
-#include "sapmvs/surface_check.h"
+#include "run/run_profile.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/evaluate/surface_check.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/run/dense_run.h"
+#include "sapmvs/simulate/simulate.h"
+#include "sapmvs/util/error.h"
 #include "truth_check.h"
+#include "util/option_flags.h"
 
 using namespace sapmvs;
 namespace fs = std::filesystem;

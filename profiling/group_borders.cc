@@ -20,13 +20,13 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/cloud_merge.h"
-#include "sapmvs/error.h"
-#include "sapmvs/ply_io.h"
-#include "sapmvs/raster_io.h"
-#include "sapmvs/surface_check.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/evaluate/surface_check.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/run/cloud_merge.h"
+#include "sapmvs/util/error.h"
 
 using namespace sapmvs;
 

@@ -13,9 +13,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/util/error.h"
 
 using namespace sapmvs;
 

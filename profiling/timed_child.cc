@@ -11,7 +11,7 @@
 #include <cstring>
 #include <sstream>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs {
 

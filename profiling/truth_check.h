@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <optional>
 
-#include "sapmvs/block.h"
-#include "sapmvs/ply_io.h"
-#include "sapmvs/raster_io.h"
-#include "sapmvs/surface_check.h"
+#include "sapmvs/block/block.h"
+#include "sapmvs/evaluate/surface_check.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
 
 namespace sapmvs {
 

@@ -37,12 +37,12 @@
 #include <sstream>
 #include <thread>
 
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/cloud_merge.h"
-#include "sapmvs/error.h"
-#include "sapmvs/export_frame.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/export_frame.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/run/cloud_merge.h"
+#include "sapmvs/util/error.h"
 #include "timed_child.h"
 #include "truth_check.h"
 

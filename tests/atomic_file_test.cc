@@ -1,4 +1,4 @@
-#include "sapmvs/atomic_file.h"
+#include "sapmvs/util/atomic_file.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -11,7 +11,7 @@
 #include <string>
 
 #include "file_size_limit.h"
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

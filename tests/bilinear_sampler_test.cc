@@ -1,4 +1,4 @@
-#include "bilinear_sampler.h"
+#include "device/bilinear_sampler.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cl_test_fixture.h"
-#include "sapmvs/kernel_limits.h"
+#include "sapmvs/util/kernel_limits.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -8,8 +8,8 @@
 #include <iomanip>
 
 #include "cli_test_util.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -1,4 +1,4 @@
-#include "sapmvs/block_export.h"
+#include "sapmvs/block/block_export.h"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "export_test_block.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/export_frame.h"
-#include "sapmvs/image_io.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/export_frame.h"
+#include "sapmvs/block/image_io.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

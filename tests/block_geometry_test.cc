@@ -1,8 +1,8 @@
-#include "sapmvs/block_geometry.h"
+#include "sapmvs/block/block_geometry.h"
 
 #include <gtest/gtest.h>
 
-#include "sapmvs/block_reader.h"
+#include "sapmvs/block/block_reader.h"
 #include "test_util.h"
 
 namespace sapmvs {

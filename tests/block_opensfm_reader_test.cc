@@ -12,9 +12,9 @@
 #include <sstream>
 
 #include "bad_inputs_fixture.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/image_io.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/image_io.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

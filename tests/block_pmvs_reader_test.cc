@@ -3,8 +3,8 @@
 #include <fstream>
 #include <iomanip>
 
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

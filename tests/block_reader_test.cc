@@ -1,10 +1,10 @@
-#include "sapmvs/block_reader.h"
+#include "sapmvs/block/block_reader.h"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

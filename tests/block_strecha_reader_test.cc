@@ -2,8 +2,8 @@
 
 #include <fstream>
 
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

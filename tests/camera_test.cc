@@ -1,4 +1,4 @@
-#include "sapmvs/camera.h"
+#include "sapmvs/block/camera.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <opencv2/calib3d.hpp>
 #include <random>
 
-#include "sapmvs/error.h"
-#include "sapmvs/image_io.h"
+#include "sapmvs/block/image_io.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs {
 namespace {

@@ -1,4 +1,4 @@
-#include "cl_runtime.h"
+#include "device/cl_runtime.h"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "cl_error.h"
 #include "cl_test_fixture.h"
-#include "sapmvs/kernel_limits.h"
+#include "device/cl_error.h"
+#include "sapmvs/util/kernel_limits.h"
 
 namespace sapmvs {
 namespace {

@@ -14,7 +14,7 @@
 #include <optional>
 #include <string>
 
-#include "cl_runtime.h"
+#include "device/cl_runtime.h"
 #include "test_util.h"
 
 namespace sapmvs::test {

@@ -2,9 +2,9 @@
 
 #include <filesystem>
 
-#include "cl_runtime.h"
 #include "cli_test_util.h"
-#include "sapmvs/error.h"
+#include "device/cl_runtime.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "cli_test_util.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/ply_io.h"
-#include "sapmvs/raster_io.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
 #include "test_util.h"
 
 namespace sapmvs {

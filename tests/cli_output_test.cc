@@ -13,10 +13,10 @@
 #include <sstream>
 #include <string>
 
-#include "cl_runtime.h"
 #include "cli_test_util.h"
-#include "sapmvs/error.h"
-#include "sapmvs/output_folder.h"
+#include "device/cl_runtime.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/output_folder.h"
 #include "test_util.h"
 
 namespace sapmvs {

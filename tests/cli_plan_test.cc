@@ -11,8 +11,8 @@
 #include <regex>
 
 #include "cli_test_util.h"
-#include "sapmvs/simulate.h"
-#include "sim_presets.h"
+#include "sapmvs/simulate/simulate.h"
+#include "simulate/sim_presets.h"
 
 namespace sapmvs {
 namespace {

@@ -18,9 +18,9 @@
 #include <string>
 
 #include "cli_test_util.h"
-#include "sapmvs/cloud_las.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/run/cloud_las.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -11,13 +11,13 @@
 #include <sstream>
 #include <string>
 
-#include "cl_runtime.h"
 #include "cli_test_util.h"
-#include "sapmvs/cloud_merge.h"
-#include "sapmvs/error.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/ply_io.h"
-#include "sapmvs/raster_io.h"
+#include "device/cl_runtime.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/run/cloud_merge.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

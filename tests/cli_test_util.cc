@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "cl_runtime.h"
-#include "sapmvs/error.h"
+#include "device/cl_runtime.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs::test {

@@ -1,4 +1,4 @@
-#include "sapmvs/cloud_dsm.h"
+#include "sapmvs/run/cloud_dsm.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <fstream>
 #include <random>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

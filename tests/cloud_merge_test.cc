@@ -1,10 +1,10 @@
-#include "sapmvs/cloud_merge.h"
+#include "sapmvs/run/cloud_merge.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs {
 namespace {

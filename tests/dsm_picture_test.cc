@@ -1,6 +1,6 @@
 // The DSM's pictures: dsm_color.tif on the DSM's grid and CRS, dsm.png with
 // its world file and legend, heights coloured with a hue that falls steadily.
-#include "sapmvs/dsm_picture.h"
+#include "sapmvs/run/dsm_picture.h"
 
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -7,7 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
-#include "sapmvs/evaluate.h"
+#include "sapmvs/evaluate/evaluate.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -1,4 +1,4 @@
-#include "sapmvs/evaluate.h"
+#include "sapmvs/evaluate/evaluate.h"
 
 #include <gtest/gtest.h>
 
@@ -12,12 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "dsm_reference.h"
-#include "lidar_reference.h"
-#include "sapmvs/error.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/ply_io.h"
-#include "sapmvs/raster_io.h"
+#include "evaluate/dsm_reference.h"
+#include "evaluate/lidar_reference.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -1,4 +1,4 @@
-#include "feature_detector.h"
+#include "match/feature_detector.h"
 
 #include <gtest/gtest.h>
 

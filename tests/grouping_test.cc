@@ -1,4 +1,5 @@
-#include "sapmvs/grouping.h"
+#include "sapmvs/plan/grouping.h"
+#include "sapmvs/util/byte_size.h"
 
 #include <gtest/gtest.h>
 
@@ -8,11 +9,11 @@
 #include <random>
 #include <set>
 
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/error.h"
-#include "sapmvs/simulate.h"
-#include "sim_presets.h"
-#include "strip_detection.h"
+#include "plan/strip_detection.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/simulate/simulate.h"
+#include "sapmvs/util/error.h"
+#include "simulate/sim_presets.h"
 
 namespace sapmvs {
 namespace {

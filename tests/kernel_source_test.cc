@@ -1,4 +1,4 @@
-#include "kernel_source.h"
+#include "device/kernel_source.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cl_test_fixture.h"
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -1,4 +1,4 @@
-#include "sapmvs/las_io.h"
+#include "sapmvs/io/las_io.h"
 
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

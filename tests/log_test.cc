@@ -1,4 +1,4 @@
-#include "sapmvs/log.h"
+#include "sapmvs/util/log.h"
 
 #include <cpl_error.h>
 #include <gtest/gtest.h>
@@ -7,9 +7,9 @@
 #include <regex>
 #include <sstream>
 
-#include "gdal_messages.h"
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
+#include "util/gdal_messages.h"
 
 namespace sapmvs {
 namespace {

@@ -1,42 +1,351 @@
-#include "match_group.h"
+#include "sapmvs/match/match_group.h"
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <random>
+#include <string>
+#include <vector>
+
+#include "cl_test_fixture.h"
+#include "device/cl_patch_kernels.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/evaluate/surface_check.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/util/error.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+namespace fs = std::filesystem;
 
-TEST(TriangulationAngleDeg, KnownAngles) {
-  const Eigen::Vector3d x(0, 0, 0);
-  EXPECT_NEAR(TriangulationAngleDeg({1, 0, 0}, {0, 1, 0}, x), 90.0, 1e-12);
-  EXPECT_NEAR(TriangulationAngleDeg({5, 0, 0}, {-7, 0, 0}, x), 180.0, 1e-12);
-  EXPECT_NEAR(TriangulationAngleDeg({3, 3, 3}, {1, 1, 1}, x), 0.0, 1e-5);
-  EXPECT_NEAR(TriangulationAngleDeg({1, 0, 0}, {1, 1, 0}, x), 45.0, 1e-12);
-  // Two cameras 100 up, 2 h tan(15 deg) apart, see the point between them at 30 degrees.
-  const double half = 100 * std::tan(15.0 * kPi / 180.0);
-  EXPECT_NEAR(TriangulationAngleDeg({512000 - half, 5405000, 400}, {512000 + half, 5405000, 400},
-                                    {512000, 5405000, 300}),
-              30.0, 1e-9);
+// ---- Options -------------------------------------------------------------
+
+// Check() logs its first failing condition; the tests keep stderr quiet.
+bool CheckQuietly(const MatcherOptions& o) {
+  ::testing::internal::CaptureStderr();
+  const bool ok = o.Check();
+  ::testing::internal::GetCapturedStderr();
+  return ok;
 }
 
-TEST(TriangulationAngleDeg, SymmetricAndIndependentOfDistanceAlongTheRays) {
-  std::mt19937 rng(31);
-  std::uniform_real_distribution<double> unit(-1, 1), scale(0.1, 10);
-  for (int trial = 0; trial < 100; ++trial) {
-    const Eigen::Vector3d x(100 * unit(rng), 100 * unit(rng), 10 * unit(rng));
-    const Eigen::Vector3d da = Eigen::Vector3d(unit(rng), unit(rng), 1).normalized();
-    const Eigen::Vector3d db = Eigen::Vector3d(unit(rng), unit(rng), 1).normalized();
-    const double expected = std::acos(da.dot(db)) * 180.0 / kPi;
-    const double got = TriangulationAngleDeg(x + 50 * da, x + 80 * db, x);
-    EXPECT_NEAR(got, expected, 1e-9) << "trial " << trial;
-    EXPECT_NEAR(TriangulationAngleDeg(x + 80 * db, x + 50 * da, x), got, 1e-12);
-    EXPECT_NEAR(TriangulationAngleDeg(x + scale(rng) * da, x + scale(rng) * db, x), got, 1e-9);
+// Runs Check() and returns what it logged.
+std::string CheckMessage(const MatcherOptions& o) {
+  ::testing::internal::CaptureStderr();
+  o.Check();
+  return ::testing::internal::GetCapturedStderr();
+}
+
+TEST(MatcherOptions, DefaultsPassCheckInBothModes) {
+  MatcherOptions o;
+  EXPECT_TRUE(CheckQuietly(o)) << CheckMessage(o);
+  EXPECT_EQ(o.adaptive_sizes.back(), o.window_size);
+  o.mode = MatchMode::kPmvs;
+  EXPECT_TRUE(CheckQuietly(o)) << CheckMessage(o);
+  EXPECT_TRUE(CheckMessage(MatcherOptions{}).empty());
+}
+
+TEST(MatcherOptions, BadValuesFailCheckNamingTheValue) {
+  struct Case {
+    const char* what;
+    void (*set)(MatcherOptions&);
+    const char* names;  // Check() names this in its message
+  };
+  const Case cases[] = {
+      {"even window_size", [](MatcherOptions& o) { o.window_size = 8; }, "window_size"},
+      {"window_size 1", [](MatcherOptions& o) { o.window_size = 1; }, "window_size"},
+      {"adaptive_sizes not ending with window_size",
+       [](MatcherOptions& o) {
+         o.adaptive_sizes = {21, 15, 11};
+       },
+       "adaptive_sizes"},
+      {"adaptive_sizes empty", [](MatcherOptions& o) { o.adaptive_sizes.clear(); },
+       "adaptive_sizes"},
+      {"adaptive_sizes increasing",
+       [](MatcherOptions& o) {
+         o.adaptive_sizes = {11, 15, 7};
+       },
+       "adaptive_sizes"},
+      {"adaptive_sizes even",
+       [](MatcherOptions& o) {
+         o.adaptive_sizes = {21, 16, 7};
+       },
+       "adaptive_sizes"},
+      {"min_image_num 1", [](MatcherOptions& o) { o.min_image_num = 1; }, "min_image_num"},
+      {"threshold_before > threshold",
+       [](MatcherOptions& o) {
+         o.threshold = 0.5;
+         o.threshold_before = 0.6;
+       },
+       "threshold_before"},
+      {"threshold above 1", [](MatcherOptions& o) { o.threshold = 1.5; }, "threshold"},
+      {"level -1", [](MatcherOptions& o) { o.level = -1; }, "level"},
+      {"cell_size 0", [](MatcherOptions& o) { o.cell_size = 0; }, "cell_size"},
+      {"max_angle_deg 90", [](MatcherOptions& o) { o.max_angle_deg = 90; }, "max_angle_deg"},
+      {"view_angle_deg NaN", [](MatcherOptions& o) { o.view_angle_deg = std::nan(""); },
+       "view_angle_deg"},
+      {"features_per_block 0", [](MatcherOptions& o) { o.features_per_block = 0; },
+       "features_per_block"},
+      {"epipolar_distance 0", [](MatcherOptions& o) { o.epipolar_distance = 0; },
+       "epipolar_distance"},
+      {"max_wave 0", [](MatcherOptions& o) { o.max_wave = 0; }, "max_wave"},
+      {"min_cluster_size -1", [](MatcherOptions& o) { o.min_cluster_size = -1; },
+       "min_cluster_size"},
+  };
+  for (const Case& c : cases) {
+    MatcherOptions o;
+    c.set(o);
+    const std::string message = CheckMessage(o);
+    EXPECT_FALSE(CheckQuietly(o)) << c.what;
+    EXPECT_NE(message.find(c.names), std::string::npos) << c.what << ": " << message;
+    EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << c.what << ": " << message;
   }
+}
+
+TEST(MatcherOptions, PmvsModeIgnoresAdaptiveSizes) {
+  MatcherOptions o;
+  o.mode = MatchMode::kPmvs;
+  o.adaptive_sizes = {21, 15, 11};
+  EXPECT_TRUE(CheckQuietly(o)) << CheckMessage(o);
+  o.mode = MatchMode::kSapmvs;
+  EXPECT_FALSE(CheckQuietly(o));
+}
+
+TEST(MatchMode, ParsesAndPrintsBothModes) {
+  EXPECT_EQ(ParseMatchMode("sapmvs"), MatchMode::kSapmvs);
+  EXPECT_EQ(ParseMatchMode("pmvs"), MatchMode::kPmvs);
+  EXPECT_EQ(ParseMatchMode(ToString(MatchMode::kSapmvs)), MatchMode::kSapmvs);
+  EXPECT_EQ(ParseMatchMode(ToString(MatchMode::kPmvs)), MatchMode::kPmvs);
+}
+
+TEST(MatchMode, UnknownModeThrowsNamingIt) {
+  for (const std::string bad : {"x", "PMVS", "", "sapmvs "}) {
+    try {
+      ParseMatchMode(bad);
+      ADD_FAILURE() << "no error for '" << bad << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("'" + bad + "'"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// ---- End to end on the simulated tiny block -------------------------------
+
+class MatchGroupTest : public test::ClTest {
+ public:
+  struct Measured {
+    MatchResult result;
+    SurfaceCheck check;
+    SurfaceCheck random_check;  // a random cloud of the same size and extent
+    double gsd = 0;             // block GSD (level 0)
+  };
+
+ protected:
+  // The tiny preset, simulated once per test process (in-process, ~6 s).
+  static fs::path TinyDir() { return test::Simulated("tiny", 1); }
+
+  static MatcherOptions Options(MatchMode mode) {
+    MatcherOptions o;
+    o.mode = mode;
+    if (mode == MatchMode::kPmvs) o.adaptive_sizes = {o.window_size};
+    o.min_image_num = 2;  // 4 images in 2 strips
+    o.progress = false;
+    return o;
+  }
+
+  Measured MatchAndCheck(const MatcherOptions& options) {
+    Measured m;
+    const Block block = ReadBlock(TinyDir() / "block.yaml");
+    const auto kernels = MakeClPatchKernels(context());
+    m.result = MatchGroup(block, {}, options, *kernels);
+    const GeoRaster dsm = ReadGeoRaster(TinyDir() / "truth" / "dsm.tif");
+    m.gsd = EstimateBlockGeometry(block).gsd_median;
+    SurfaceCheckOptions so;
+    so.tolerance = 2 * m.gsd;
+    so.cell_size = 4 * m.result.stats.gsd;  // the working level's GSD
+    so.min_images = options.min_image_num;
+    m.check = CheckAgainstSurface(m.result.cloud, dsm, block, so);
+    // Control: as many points, uniformly over the cloud's bounding box.
+    PointCloud random;
+    if (!m.result.cloud.points.empty()) {
+      Eigen::Vector3d lo = m.result.cloud.points[0].position, hi = lo;
+      for (const CloudPoint& p : m.result.cloud.points) {
+        lo = lo.cwiseMin(p.position);
+        hi = hi.cwiseMax(p.position);
+      }
+      std::mt19937 rng(5);
+      std::uniform_real_distribution<double> unit(0, 1);
+      for (size_t i = 0; i < m.result.cloud.points.size(); ++i) {
+        CloudPoint p;
+        p.position = lo + (hi - lo).cwiseProduct(Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
+        random.points.push_back(p);
+      }
+    }
+    m.random_check = CheckAgainstSurface(random, dsm, block, so);
+    const MatchStats& s = m.result.stats;
+    std::printf(
+        "[ measured ] %s: %ld points (%ld before filter), share within 2 GSD %.4f, median |dz| "
+        "%.4f m = %.3f GSD, coverage %.4f (%ld of %ld cells of %.3f m); random cloud: share "
+        "%.4f, coverage %.4f; block GSD %.4f m, level GSD %.4f m\n",
+        ToString(options.mode).c_str(), s.points, s.points_before_filter, m.check.share_within,
+        m.check.median_abs_dz, m.check.median_abs_dz / m.gsd, m.check.coverage,
+        m.check.cells_covered, m.check.cells_seen, so.cell_size, m.random_check.share_within,
+        m.random_check.coverage, m.gsd, s.gsd);
+    return m;
+  }
+
+  // Every point is well formed and passed the options' thresholds.
+  static void ExpectPointsWellFormed(const PointCloud& cloud, const MatcherOptions& o) {
+    EXPECT_TRUE(cloud.has_normals);
+    EXPECT_TRUE(cloud.has_colors);
+    EXPECT_TRUE(cloud.has_scores);
+    EXPECT_TRUE(cloud.has_views);
+    long bad = 0;
+    for (size_t i = 0; i < cloud.points.size(); ++i) {
+      const CloudPoint& p = cloud.points[i];
+      const bool ok = p.position.allFinite() && p.normal.allFinite() &&
+                      std::abs(p.normal.norm() - 1.0f) < 1e-3f && p.num_views >= o.min_image_num &&
+                      p.num_views <= 4 && std::isfinite(p.score) && p.score >= o.threshold - 1e-6 &&
+                      p.score <= 1.0f + 1e-6f;
+      if (!ok && ++bad <= 5) {
+        ADD_FAILURE() << "point " << i << ": (" << p.position.transpose() << "), normal ("
+                      << p.normal.transpose() << "), views " << p.num_views << ", score "
+                      << p.score;
+      }
+    }
+    EXPECT_EQ(bad, 0);
+  }
+};
+
+// Acceptance floors against truth/dsm.tif. Measured on PoCL (tiny preset,
+// seed 1, level 1, min_image_num 2, default options):
+//   sapmvs: 55909 points, share within 2 GSD 0.906, median |dz| 0.300 GSD,
+//           coverage 0.700;
+//   pmvs:   14464 points, share within 2 GSD 0.967, median |dz| 0.230 GSD,
+//           coverage 0.710;
+//   a random cloud of the same size and extent: share 0.02 to 0.05,
+//   coverage 0.06 to 0.11.
+// The previous filter (plane tolerance 1.5 footprints, no score fence, no
+// free-space test) measured shares of 0.774 / 0.871 with coverage 0.763 /
+// 0.785: the share floors fail with it. The floors sit below the
+// measurements by a margin for PoCL builds on other CPUs.
+struct Floors {
+  long points;
+  double share_within;
+  double median_abs_dz_gsd;  // upper bound, block GSDs
+  double coverage;
+};
+
+void ExpectMeetsFloors(const MatchGroupTest::Measured& m, const Floors& f) {
+  EXPECT_GE(m.result.stats.points, f.points);
+  EXPECT_GE(m.check.share_within, f.share_within);
+  EXPECT_LT(m.check.median_abs_dz, f.median_abs_dz_gsd * m.gsd);
+  EXPECT_GE(m.check.coverage, f.coverage);
+  // The floors mean something: a random cloud is far below them.
+  EXPECT_LT(m.random_check.share_within, 0.5 * f.share_within);
+  EXPECT_LT(m.random_check.coverage, 0.5 * f.coverage);
+}
+
+TEST_F(MatchGroupTest, SapmvsModeMatchesTheTrueSurface) {
+  const MatcherOptions o = Options(MatchMode::kSapmvs);
+  SCOPED_TRACE("mode " + ToString(o.mode));
+  const Measured m = MatchAndCheck(o);
+  const MatchStats& s = m.result.stats;
+  EXPECT_EQ(s.points, static_cast<long>(m.result.cloud.points.size()));
+  EXPECT_EQ(s.images, 4);
+  EXPECT_NEAR(s.gsd, 2 * m.gsd, 0.2 * m.gsd);  // level 1
+  EXPECT_GT(s.seeds_accepted, 0);
+  EXPECT_GT(s.patches, 0);
+  // Every adaptive size is a size the patches may take.
+  for (const auto& [size, count] : s.accepted_by_size) {
+    EXPECT_NE(std::find(o.adaptive_sizes.begin(), o.adaptive_sizes.end(), size),
+              o.adaptive_sizes.end())
+        << size;
+  }
+  ExpectMeetsFloors(m, {30000, 0.85, 0.45, 0.58});
+  ExpectPointsWellFormed(m.result.cloud, o);
+}
+
+TEST_F(MatchGroupTest, PmvsModeMatchesTheTrueSurface) {
+  const MatcherOptions o = Options(MatchMode::kPmvs);
+  SCOPED_TRACE("mode " + ToString(o.mode));
+  const Measured m = MatchAndCheck(o);
+  const MatchStats& s = m.result.stats;
+  EXPECT_EQ(s.points, static_cast<long>(m.result.cloud.points.size()));
+  EXPECT_EQ(s.images, 4);
+  EXPECT_NEAR(s.gsd, 2 * m.gsd, 0.2 * m.gsd);  // level 1
+  EXPECT_GT(s.seeds_accepted, 0);
+  // One window size only.
+  for (const auto& [size, count] : s.accepted_by_size) EXPECT_EQ(size, o.window_size);
+  ExpectMeetsFloors(m, {8000, 0.9, 0.4, 0.63});
+  ExpectPointsWellFormed(m.result.cloud, o);
+}
+
+// PMVS's expand-filter loop: the passes after the first grow the surviving
+// patches into the cells the filter freed, which covers more of the ground.
+TEST_F(MatchGroupTest, LaterPassesGrowIntoTheCellsTheFilterFreed) {
+  MatcherOptions o = Options(MatchMode::kSapmvs);
+  o.expand_iterations = 1;
+  const Measured one = MatchAndCheck(o);
+  o.expand_iterations = 3;
+  const Measured three = MatchAndCheck(o);
+  EXPECT_GT(three.result.stats.points_before_filter, one.result.stats.points_before_filter);
+  EXPECT_GT(three.result.stats.waves, one.result.stats.waves);
+  EXPECT_GT(three.result.stats.points, one.result.stats.points);
+  EXPECT_GT(three.check.cells_covered, one.check.cells_covered);
+  // Filtered like the first pass's points, the new ones keep the accuracy.
+  EXPECT_GT(three.check.share_within, one.check.share_within - 0.03);
+  // The passes' times add up under one stage name each.
+  int propagation = 0;
+  for (const auto& [name, t] : three.result.stats.stages) propagation += name == "propagation";
+  EXPECT_EQ(propagation, 1);
+}
+
+// The NGI aerial block at full resolution: the cloud follows the DEM, with no
+// gross errors. Before the seed-depth fences in MatchGroup, 229 points of a
+// false cluster sat 3.3 to 4.1 km below the ground here.
+class MatchRealBlockTest : public test::ClTest {};
+
+TEST_F(MatchRealBlockTest, NgiCloudFollowsTheDemWithoutGrossErrors) {
+  const std::filesystem::path yaml = test::TestDir() / "blocks" / "ngi.yaml";
+  const std::filesystem::path dem_path =
+      test::SharedDir() / "datasets" / "orthority_ngi_odm" / "ngi" / "dem.tif";
+  if (!std::filesystem::exists(dem_path)) GTEST_SKIP() << "no " << dem_path;
+  const Block block = ReadBlock(yaml);
+  MatcherOptions o;
+  o.level = 0;
+  o.progress = false;
+  const auto kernels = MakeClPatchKernels(context());
+  const MatchResult r = MatchGroup(block, {}, o, *kernels);
+  const GeoRaster dem = ReadGeoRaster(dem_path);
+  const double gsd = EstimateBlockGeometry(block).gsd_median;  // about 6 m
+  std::vector<double> abs_dz;
+  double worst = 0;
+  for (const CloudPoint& p : r.cloud.points) {
+    const int col = static_cast<int>((p.position.x() - dem.origin_x) / dem.cell_size);
+    const int row = static_cast<int>((dem.origin_y - p.position.y()) / dem.cell_size);
+    if (col < 0 || row < 0 || col >= dem.width || row >= dem.height || dem.IsEmpty(col, row)) {
+      continue;
+    }
+    const double dz = std::abs(p.position.z() - dem.at(col, row));
+    abs_dz.push_back(dz);
+    worst = std::max(worst, dz);
+  }
+  ASSERT_GT(abs_dz.size(), 10000u);
+  std::nth_element(abs_dz.begin(), abs_dz.begin() + abs_dz.size() / 2, abs_dz.end());
+  const double median = abs_dz[abs_dz.size() / 2];
+  std::printf(
+      "[ measured ] NGI level 0: %zu points on the DEM, median |dz| %.2f m (%.2f GSD), "
+      "worst %.1f m\n",
+      abs_dz.size(), median, median / gsd, worst);
+  // The DEM is bare ground at 24 m cells; buildings and trees stand above it.
+  EXPECT_LT(median, gsd);
+  EXPECT_LT(worst, 25 * gsd);  // 150 m: far above any building here
 }
 
 }  // namespace

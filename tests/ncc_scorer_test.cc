@@ -1,4 +1,4 @@
-#include "ncc_scorer.h"
+#include "device/ncc_scorer.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 
 #include "cl_test_fixture.h"
 #include "plane_scene.h"
-#include "sapmvs/kernel_limits.h"
+#include "sapmvs/util/kernel_limits.h"
 #include "test_util.h"
 
 namespace sapmvs {

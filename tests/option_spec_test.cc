@@ -1,6 +1,6 @@
 // The options descriptions (option_spec.h): the range checks, flags, JSON and
 // docs/options.md that come from them.
-#include "sapmvs/option_spec.h"
+#include "sapmvs/util/option_spec.h"
 
 #include <gtest/gtest.h>
 
@@ -12,15 +12,15 @@
 #include <set>
 #include <type_traits>
 
-#include "option_flags.h"
-#include "option_json.h"
-#include "options_reference.h"
-#include "run_report.h"
-#include "sapmvs/cloud_dsm.h"
-#include "sapmvs/grouping_options.h"
-#include "sapmvs/matcher_options.h"
-#include "sapmvs/run_options.h"
+#include "run/options_reference.h"
+#include "run/run_report.h"
+#include "sapmvs/match/matcher_options.h"
+#include "sapmvs/plan/grouping_options.h"
+#include "sapmvs/run/cloud_dsm.h"
+#include "sapmvs/run/run_options.h"
 #include "test_util.h"
+#include "util/option_flags.h"
+#include "util/option_json.h"
 
 namespace sapmvs {
 namespace {

@@ -1,13 +1,13 @@
-#include "orientation_export.h"
+#include "block/orientation_export.h"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "bad_inputs_fixture.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/rotation.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/rotation.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

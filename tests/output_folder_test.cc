@@ -1,4 +1,4 @@
-#include "sapmvs/output_folder.h"
+#include "sapmvs/util/output_folder.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,9 +10,9 @@
 #include <string>
 
 #include "file_size_limit.h"
-#include "run_checkpoint.h"
-#include "run_report.h"
-#include "sapmvs/error.h"
+#include "run/run_checkpoint.h"
+#include "run/run_report.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

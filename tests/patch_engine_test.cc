@@ -1,4 +1,4 @@
-#include "patch_engine.h"
+#include "match/patch_engine.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +10,11 @@
 #include <memory>
 #include <vector>
 
-#include "cl_patch_kernels.h"
 #include "cl_test_fixture.h"
-#include "match_group.h"
+#include "device/cl_patch_kernels.h"
+#include "match/group_data.h"
 #include "plane_scene.h"
-#include "sapmvs/matcher.h"
+#include "sapmvs/match/match_group.h"
 
 namespace sapmvs {
 namespace {

@@ -1,4 +1,4 @@
-#include "patch_filter.h"
+#include "match/patch_filter.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "sapmvs/camera.h"
+#include "sapmvs/block/camera.h"
 
 namespace sapmvs {
 namespace {

@@ -3,8 +3,8 @@
 // double-precision references, rounded to float), and the two backends
 // against each other on a plane scene, at odd sizes and at the borders.
 
-#include "patch_kernels.h"
-#include "make_patch_kernels.h"
+#include "match/patch_kernels.h"
+#include "device/make_patch_kernels.h"
 
 #include <gtest/gtest.h>
 
@@ -17,14 +17,14 @@
 #include <random>
 #include <vector>
 
-#include "cl_patch_kernels.h"
 #include "cl_test_fixture.h"
-#include "ncc_score_reference.h"
-#include "patch_refine_reference.h"
+#include "device/cl_patch_kernels.h"
+#include "match/ncc_score_reference.h"
+#include "match/patch_refine_reference.h"
+#include "match/reference_patch_kernels.h"
 #include "plane_scene.h"
-#include "reference_patch_kernels.h"
-#include "sapmvs/error.h"
-#include "sapmvs/kernel_limits.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/kernel_limits.h"
 #include "test_util.h"
 
 namespace sapmvs {

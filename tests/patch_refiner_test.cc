@@ -1,4 +1,4 @@
-#include "patch_refiner.h"
+#include "device/patch_refiner.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 
 #include "cl_test_fixture.h"
 #include "plane_scene.h"
-#include "sapmvs/error.h"
-#include "sapmvs/kernel_limits.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/kernel_limits.h"
 
 namespace sapmvs {
 namespace {

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "ncc_scorer.h"
-#include "sapmvs/camera.h"
+#include "device/ncc_scorer.h"
+#include "sapmvs/block/camera.h"
 
 namespace sapmvs::test {
 

@@ -1,4 +1,4 @@
-#include "propagation.h"
+#include "match/propagation.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "sapmvs/camera.h"
+#include "sapmvs/block/camera.h"
 
 namespace sapmvs {
 namespace {

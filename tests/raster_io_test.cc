@@ -1,4 +1,4 @@
-#include "sapmvs/raster_io.h"
+#include "sapmvs/io/raster_io.h"
 
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -8,10 +8,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -15,10 +15,10 @@
 #include <string>
 
 #include "cli_test_util.h"
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/cloud_merge.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/run/cloud_merge.h"
 #include "test_util.h"
 
 namespace sapmvs {

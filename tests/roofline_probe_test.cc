@@ -1,11 +1,11 @@
-#include "roofline_probe.h"
+#include "device/roofline_probe.h"
 
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "cl_test_fixture.h"
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

@@ -1,4 +1,4 @@
-#include "sapmvs/rotation.h"
+#include "sapmvs/block/rotation.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "sapmvs/camera.h"
-#include "sapmvs/error.h"
+#include "sapmvs/block/camera.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs {
 namespace {

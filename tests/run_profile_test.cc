@@ -1,4 +1,4 @@
-#include "run_profile.h"
+#include "run/run_profile.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "run_progress.h"
+#include "util/run_progress.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "seed_matcher.h"
+#include "match/seed_matcher.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "sapmvs/camera.h"
+#include "sapmvs/block/camera.h"
 
 namespace sapmvs {
 namespace {

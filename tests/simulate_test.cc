@@ -1,4 +1,4 @@
-#include "sapmvs/simulate.h"
+#include "sapmvs/simulate/simulate.h"
 
 #include <gtest/gtest.h>
 
@@ -10,12 +10,12 @@
 #include <sstream>
 
 #include "cli_test_util.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/error.h"
-#include "sapmvs/image_io.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/raster_io.h"
-#include "sim_presets.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/image_io.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/util/error.h"
+#include "simulate/sim_presets.h"
 #include "test_util.h"
 
 namespace sapmvs {

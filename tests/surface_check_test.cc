@@ -1,4 +1,4 @@
-#include "sapmvs/surface_check.h"
+#include "sapmvs/evaluate/surface_check.h"
 
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <limits>
 #include <vector>
 
-#include "sapmvs/block.h"
-#include "sapmvs/error.h"
+#include "sapmvs/block/block.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs {
 namespace {

@@ -1,7 +1,7 @@
 #include "test_util.h"
 
-#include "sapmvs/error.h"
-#include "sapmvs/simulate.h"
+#include "sapmvs/simulate/simulate.h"
+#include "sapmvs/util/error.h"
 
 #include <fcntl.h>
 #include <sys/file.h>

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "sapmvs/camera.h"
-#include "sapmvs/image_io.h"
+#include "sapmvs/block/camera.h"
+#include "sapmvs/block/image_io.h"
 
 namespace sapmvs::test {
 

@@ -1,4 +1,4 @@
-#include "sapmvs/tie_points.h"
+#include "sapmvs/block/tie_points.h"
 
 #include <gtest/gtest.h>
 
@@ -6,9 +6,9 @@
 #include <cmath>
 #include <filesystem>
 
-#include "sapmvs/block_geometry.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/raster_io.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/raster_io.h"
 #include "test_util.h"
 
 namespace sapmvs {

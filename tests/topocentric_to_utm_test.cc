@@ -1,4 +1,4 @@
-#include "topocentric_to_utm.h"
+#include "block/topocentric_to_utm.h"
 
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
@@ -6,8 +6,8 @@
 #include <cmath>
 #include <memory>
 
-#include "sapmvs/error.h"
-#include "sapmvs/rotation.h"
+#include "sapmvs/block/rotation.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs {
 namespace {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "sapmvs/error.h"
-#include "sapmvs/las_io.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/util/error.h"
 #include "test_util.h"
 
 namespace sapmvs {

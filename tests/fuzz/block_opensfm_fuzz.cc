@@ -1,6 +1,6 @@
 // OpenSfM: input = opensfm/reconstruction.json, images/ beside opensfm/.
 #include "fuzz_util.h"
-#include "sapmvs/block_reader.h"
+#include "sapmvs/block/block_reader.h"
 
 using namespace sapmvs;
 

@@ -4,8 +4,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fuzz_util.h"
-#include "sapmvs/block_reader.h"
-#include "sapmvs/export_frame.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/export_frame.h"
 
 using namespace sapmvs;
 

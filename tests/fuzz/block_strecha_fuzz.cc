@@ -1,7 +1,7 @@
 // Strecha .camera files: input = 0000.jpg.camera [--8<-- 0001.jpg.camera
 // [--8<-- 0002.jpg.camera]] in gt_dense_cameras/, images/ beside it.
 #include "fuzz_util.h"
-#include "sapmvs/block_reader.h"
+#include "sapmvs/block/block_reader.h"
 
 using namespace sapmvs;
 

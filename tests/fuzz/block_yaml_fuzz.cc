@@ -1,6 +1,6 @@
 // block.yaml and its orientation file: input = block.yaml [--8<-- orientation.txt].
 #include "fuzz_util.h"
-#include "sapmvs/block_reader.h"
+#include "sapmvs/block/block_reader.h"
 
 using namespace sapmvs;
 

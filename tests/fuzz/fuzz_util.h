@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "sapmvs/error.h"
+#include "sapmvs/util/error.h"
 
 namespace sapmvs::fuzz {
 

@@ -1,6 +1,6 @@
 // LAS clouds: input = the file.
 #include "fuzz_util.h"
-#include "sapmvs/las_io.h"
+#include "sapmvs/io/las_io.h"
 
 using namespace sapmvs;
 

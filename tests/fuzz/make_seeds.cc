@@ -9,10 +9,10 @@
 #include <sstream>
 
 #include "fuzz_util.h"
-#include "sapmvs/cloud_las.h"
-#include "sapmvs/export_frame.h"
-#include "sapmvs/las_io.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/block/export_frame.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/run/cloud_las.h"
 
 using namespace sapmvs;
 namespace fs = std::filesystem;

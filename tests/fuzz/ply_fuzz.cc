@@ -1,6 +1,6 @@
 // PLY clouds: input = the file.
 #include "fuzz_util.h"
-#include "sapmvs/ply_io.h"
+#include "sapmvs/io/ply_io.h"
 
 using namespace sapmvs;
 

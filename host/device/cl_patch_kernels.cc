@@ -1,0 +1,128 @@
+#include "device/cl_patch_kernels.h"
+
+#include <map>
+#include <string>
+#include <tuple>
+#include <utility>
+
+#include "device/cl_runtime.h"
+#include "device/ncc_scorer.h"
+#include "device/patch_refiner.h"
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+namespace {
+
+// One scorer per distinct NccScorerOptions, one refiner per distinct
+// PatchRefinerOptions (each is a program built with those -D options).
+using ScorerKey = std::tuple<int, int, double>;
+using RefinerKey = std::tuple<int, int, int, int, double, double, double, double>;
+
+ScorerKey KeyOf(const NccScorerOptions& o) {
+  return {o.patch_size, o.work_group_size, o.sigma_color};
+}
+
+RefinerKey KeyOf(const PatchRefinerOptions& o) {
+  return {o.patch_size, o.work_group_size, o.iterations,    o.max_halvings,
+          o.depth_step, o.angle_step_deg,  o.max_angle_deg, o.sigma_color};
+}
+
+double Seconds(const ClEvent& event) {
+  return event.profiling() ? 1e-9 * static_cast<double>(event.DeviceTimeNs()) : 0.0;
+}
+
+class ClPatchKernels : public PatchKernels {
+ public:
+  ClPatchKernels(std::unique_ptr<ClContext> owned, ClContext& context)
+      : owned_(std::move(owned)), context_(context) {
+    const DeviceInfo& d = context_.device();
+    device_.description = d.Describe();
+    device_.name = d.name;
+    device_.vendor = d.vendor;
+    device_.platform = d.platform_name + " (" + d.platform_version + ")";
+    device_.type = DeviceTypeName(d.type);
+  }
+
+  const KernelDevice& device() const override { return device_; }
+
+  void SetGroup(const NccGroup& group) override {
+    ClearGroup();  // first, so that the old group's buffers are freed before the upload
+    group_ = std::make_shared<const NccDeviceGroup>(UploadNccGroup(context_, group));
+    cameras_ = group.cameras;
+  }
+
+  void ClearGroup() override {
+    // The scorers and refiners hold the group too; new ones are made on first
+    // use, from the programs the context has cached.
+    scorers_.clear();
+    refiners_.clear();
+    group_.reset();
+    cameras_.clear();
+  }
+
+  std::vector<float> Score(const NccScorerOptions& options, const std::vector<NccPatch>& patches,
+                           const std::vector<NccPair>& pairs, double* seconds) override {
+    ClEvent event;
+    std::vector<float> scores = ScorerFor(options).Score(patches, pairs, &event);
+    if (seconds != nullptr) *seconds = Seconds(event);
+    return scores;
+  }
+
+  std::vector<RefinedPatch> Refine(const PatchRefinerOptions& options,
+                                   const std::vector<NccPatch>& patches,
+                                   const std::vector<std::vector<int>>& views,
+                                   double* seconds) override {
+    ClEvent event;
+    std::vector<RefinedPatch> refined = RefinerFor(options).Refine(patches, views, &event);
+    if (seconds != nullptr) *seconds = Seconds(event);
+    return refined;
+  }
+
+ private:
+  NccScorer& ScorerFor(const NccScorerOptions& options) {
+    if (!group_) throw Error("PatchKernels::Score called before SetGroup");
+    std::unique_ptr<NccScorer>& scorer = scorers_[KeyOf(options)];
+    if (!scorer) {
+      auto made = std::make_unique<NccScorer>(context_, options);
+      made->UseGroup(group_);
+      scorer = std::move(made);
+    }
+    return *scorer;
+  }
+
+  PatchRefiner& RefinerFor(const PatchRefinerOptions& options) {
+    if (!group_) throw Error("PatchKernels::Refine called before SetGroup");
+    std::unique_ptr<PatchRefiner>& refiner = refiners_[KeyOf(options)];
+    if (!refiner) {
+      auto made = std::make_unique<PatchRefiner>(context_, options);
+      made->UseGroup(group_, cameras_);
+      refiner = std::move(made);
+    }
+    return *refiner;
+  }
+
+  std::unique_ptr<ClContext> owned_;
+  ClContext& context_;
+  KernelDevice device_;
+  std::shared_ptr<const NccDeviceGroup> group_;
+  std::vector<NccCamera> cameras_;
+  std::map<ScorerKey, std::unique_ptr<NccScorer>> scorers_;
+  std::map<RefinerKey, std::unique_ptr<PatchRefiner>> refiners_;
+};
+
+}  // namespace
+
+std::unique_ptr<PatchKernels> MakeClPatchKernels(const PatchKernelsOptions& options) {
+  DeviceOptions device_options;
+  device_options.device = options.device;
+  device_options.profile = options.profile;
+  auto context = std::make_unique<ClContext>(device_options);
+  ClContext& ref = *context;
+  return std::make_unique<ClPatchKernels>(std::move(context), ref);
+}
+
+std::unique_ptr<PatchKernels> MakeClPatchKernels(ClContext& context) {
+  return std::make_unique<ClPatchKernels>(nullptr, context);
+}
+
+}  // namespace sapmvs

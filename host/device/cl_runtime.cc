@@ -1,0 +1,583 @@
+#include "device/cl_runtime.h"
+
+#include <CL/cl_ext.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <stdexcept>
+
+#include "device/kernel_source.h"
+
+namespace sapmvs {
+namespace {
+
+constexpr char kNoPlatformMessage[] =
+    "no OpenCL platform found; install one, e.g. `sudo apt-get install pocl-opencl-icd` (CPU) "
+    "or your GPU vendor's OpenCL driver";
+
+std::string Trim(std::string_view text) {
+  const auto is_space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  while (!text.empty() && is_space(text.front())) text.remove_prefix(1);
+  while (!text.empty() && is_space(text.back())) text.remove_suffix(1);
+  return std::string(text);
+}
+
+std::string ToLower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+// Info strings come NUL-terminated and, from some drivers, space-padded.
+std::string CleanInfoString(std::string text) {
+  text.resize(std::min(text.size(), text.find('\0')));
+  return Trim(text);
+}
+
+std::string PlatformString(cl_platform_id platform, cl_platform_info param) {
+  size_t size = 0;
+  CL_CHECK(clGetPlatformInfo(platform, param, 0, nullptr, &size));
+  std::string text(size, '\0');
+  CL_CHECK(clGetPlatformInfo(platform, param, size, text.data(), nullptr));
+  return CleanInfoString(std::move(text));
+}
+
+std::string DeviceString(cl_device_id device, cl_device_info param) {
+  size_t size = 0;
+  CL_CHECK(clGetDeviceInfo(device, param, 0, nullptr, &size));
+  std::string text(size, '\0');
+  CL_CHECK(clGetDeviceInfo(device, param, size, text.data(), nullptr));
+  return CleanInfoString(std::move(text));
+}
+
+template <typename T>
+T DeviceValue(cl_device_id device, cl_device_info param) {
+  T value{};
+  CL_CHECK(clGetDeviceInfo(device, param, sizeof(T), &value, nullptr));
+  return value;
+}
+
+DeviceInfo QueryDevice(cl_platform_id platform, int platform_index, cl_device_id id) {
+  DeviceInfo info;
+  info.platform_index = platform_index;
+  info.platform_name = PlatformString(platform, CL_PLATFORM_NAME);
+  info.platform_version = PlatformString(platform, CL_PLATFORM_VERSION);
+  info.platform_id = platform;
+  info.id = id;
+  info.name = DeviceString(id, CL_DEVICE_NAME);
+  info.vendor = DeviceString(id, CL_DEVICE_VENDOR);
+  const auto type = DeviceValue<cl_device_type>(id, CL_DEVICE_TYPE);
+  info.type = (type & CL_DEVICE_TYPE_GPU)   ? DeviceType::kGpu
+              : (type & CL_DEVICE_TYPE_CPU) ? DeviceType::kCpu
+                                            : DeviceType::kOther;
+  info.available = DeviceValue<cl_bool>(id, CL_DEVICE_AVAILABLE) &&
+                   DeviceValue<cl_bool>(id, CL_DEVICE_COMPILER_AVAILABLE);
+  info.global_mem_bytes = DeviceValue<cl_ulong>(id, CL_DEVICE_GLOBAL_MEM_SIZE);
+  info.max_alloc_bytes = DeviceValue<cl_ulong>(id, CL_DEVICE_MAX_MEM_ALLOC_SIZE);
+  info.local_mem_bytes = DeviceValue<cl_ulong>(id, CL_DEVICE_LOCAL_MEM_SIZE);
+  info.compute_units = static_cast<int>(DeviceValue<cl_uint>(id, CL_DEVICE_MAX_COMPUTE_UNITS));
+  info.max_work_group_size = DeviceValue<size_t>(id, CL_DEVICE_MAX_WORK_GROUP_SIZE);
+  const auto dims = DeviceValue<cl_uint>(id, CL_DEVICE_MAX_WORK_ITEM_DIMENSIONS);
+  info.max_work_item_sizes.resize(dims);
+  CL_CHECK(clGetDeviceInfo(id, CL_DEVICE_MAX_WORK_ITEM_SIZES, dims * sizeof(size_t),
+                           info.max_work_item_sizes.data(), nullptr));
+  info.image_support = DeviceValue<cl_bool>(id, CL_DEVICE_IMAGE_SUPPORT) != CL_FALSE;
+  info.version = DeviceString(id, CL_DEVICE_VERSION);
+  info.opencl_c_version = DeviceString(id, CL_DEVICE_OPENCL_C_VERSION);
+  return info;
+}
+
+std::string DeviceList(const std::vector<DeviceInfo>& devices) {
+  std::string list;
+  for (const DeviceInfo& device : devices) {
+    if (!list.empty()) list += "; ";
+    list += device.Describe();
+  }
+  return list;
+}
+
+bool IsIndexSpec(const std::string& spec) {
+  const size_t digits = spec.size() > 1 && spec[0] == '-' ? 1 : 0;
+  return spec.size() > digits && std::all_of(spec.begin() + digits, spec.end(), [](char c) {
+           return std::isdigit(static_cast<unsigned char>(c)) != 0;
+         });
+}
+
+DeviceInfo SelectedDevice(const DeviceOptions& options) {
+  if (!options.Check()) {
+    throw Error("invalid --device \"" + options.device +
+                "\": expected a device index (0, 1, ...) or part of a device name");
+  }
+  const std::vector<DeviceInfo> devices = ListDevices();
+  return devices[SelectDeviceIndex(devices, options)];
+}
+
+std::string LaunchContext(const ClKernel& kernel, const DeviceInfo& device) {
+  return "cannot launch kernel " + kernel.name() + " on " + device.name + ": ";
+}
+
+}  // namespace
+
+const char* DeviceTypeName(DeviceType type) {
+  switch (type) {
+    case DeviceType::kGpu:
+      return "GPU";
+    case DeviceType::kCpu:
+      return "CPU";
+    case DeviceType::kOther:
+      break;
+  }
+  return "other";
+}
+
+bool DeviceInfo::IsPoclCpu() const {
+  return type == DeviceType::kCpu &&
+         (platform_name == "Portable Computing Language" ||
+          ToLower(platform_name + " " + platform_version).find("pocl") != std::string::npos);
+}
+
+std::string DeviceInfo::MatchText() const {
+  return platform_name + " " + platform_version + " " + name + " " + vendor;
+}
+
+std::string DeviceInfo::Describe() const {
+  return std::to_string(index) + ": " + platform_name + " / " + name + " (" + DeviceTypeName(type) +
+         ")";
+}
+
+std::string ShortClVersion(const std::string& version) {
+  for (const std::string prefix : {"OpenCL C ", "OpenCL "}) {
+    if (version.rfind(prefix, 0) == 0) {
+      const std::string rest = version.substr(prefix.size());
+      return rest.substr(0, rest.find(' '));
+    }
+  }
+  return version;
+}
+
+std::vector<DeviceInfo> ListDevices() {
+  cl_uint num_platforms = 0;
+  const cl_int status = clGetPlatformIDs(0, nullptr, &num_platforms);
+  // The ICD loader reports "no vendor file installed" as CL_PLATFORM_NOT_FOUND_KHR.
+  if (status == CL_PLATFORM_NOT_FOUND_KHR || (status == CL_SUCCESS && num_platforms == 0)) {
+    throw NoDeviceError(kNoPlatformMessage);
+  }
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clGetPlatformIDs(0, nullptr, &num_platforms)", __FILE__, __LINE__);
+  }
+  std::vector<cl_platform_id> platforms(num_platforms);
+  CL_CHECK(clGetPlatformIDs(num_platforms, platforms.data(), nullptr));
+
+  std::vector<DeviceInfo> devices;
+  for (cl_uint p = 0; p < num_platforms; ++p) {
+    // One broken driver (say, a GPU ICD without its kernel module) must not
+    // hide the working ones, so a failing platform is skipped with a note.
+    try {
+      cl_uint num_devices = 0;
+      const cl_int device_status =
+          clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, 0, nullptr, &num_devices);
+      if (device_status == CL_DEVICE_NOT_FOUND || num_devices == 0) continue;
+      CL_CHECK(device_status);
+      std::vector<cl_device_id> ids(num_devices);
+      CL_CHECK(clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, num_devices, ids.data(), nullptr));
+      for (cl_device_id id : ids) {
+        devices.push_back(QueryDevice(platforms[p], static_cast<int>(p), id));
+        devices.back().index = static_cast<int>(devices.size() - 1);
+      }
+    } catch (const ClError& e) {
+      std::cerr << "sapmvs: warning: skipping OpenCL platform " << p << ": " << e.what() << "\n";
+    }
+  }
+  if (devices.empty()) {
+    throw NoDeviceError("no OpenCL device found on " + std::to_string(num_platforms) +
+                        " OpenCL platform(s); install one, e.g. `sudo apt-get install "
+                        "pocl-opencl-icd` (CPU) or your GPU vendor's OpenCL driver");
+  }
+  return devices;
+}
+
+bool DeviceOptions::Check() const {
+  const std::string spec = Trim(device);
+  if (IsIndexSpec(spec) && spec[0] == '-') return false;
+  return std::none_of(spec.begin(), spec.end(),
+                      [](char c) { return std::iscntrl(static_cast<unsigned char>(c)) != 0; });
+}
+
+DeviceSpec EffectiveDeviceSpec(const DeviceOptions& options) {
+  return DeviceSpecFor(options.device);
+}
+
+int DefaultDeviceIndex(const std::vector<DeviceInfo>& devices) {
+  // Unavailable devices (busy, no compiler) are a last resort.
+  for (const bool need_available : {true, false}) {
+    for (const DeviceInfo& d : devices) {
+      if (d.type == DeviceType::kGpu && (d.available || !need_available)) return d.index;
+    }
+    for (const DeviceInfo& d : devices) {
+      if (d.IsPoclCpu() && (d.available || !need_available)) return d.index;
+    }
+  }
+  if (devices.empty()) throw NoDeviceError(kNoPlatformMessage);
+  return devices.front().index;
+}
+
+int SelectDeviceIndex(const std::vector<DeviceInfo>& devices, const DeviceOptions& options) {
+  const DeviceSpec spec = EffectiveDeviceSpec(options);
+  if (spec.value.empty()) return DefaultDeviceIndex(devices);
+  const std::string origin = " (from " + spec.source + ")";
+  if (IsIndexSpec(spec.value)) {
+    unsigned long long index = 0;  // NOLINT(runtime/int): from_chars' natural type.
+    const char* end = spec.value.data() + spec.value.size();
+    const auto [ptr, ec] = std::from_chars(spec.value.data(), end, index);
+    if (ec == std::errc() && ptr == end && index < devices.size()) {
+      return static_cast<int>(index);
+    }
+    throw NoDeviceError("OpenCL device index " + spec.value + origin +
+                        " is out of range; available: " + DeviceList(devices));
+  }
+  const std::string needle = ToLower(spec.value);
+  for (const DeviceInfo& device : devices) {
+    if (ToLower(device.MatchText()).find(needle) != std::string::npos) return device.index;
+  }
+  throw NoDeviceError("no OpenCL device matches \"" + spec.value + "\"" + origin +
+                      "; available: " + DeviceList(devices));
+}
+
+// ---------------------------------------------------------------------------
+
+void ClEvent::Wait() const {
+  const cl_event event = event_.get();
+  if (event != nullptr) CL_CHECK(clWaitForEvents(1, &event));
+}
+
+uint64_t ClEvent::DeviceTimeNs() const {
+  if (!profiling_) {
+    throw Error(
+        "device timing needs a profiling queue; create the ClContext with "
+        "DeviceOptions::profile = true");
+  }
+  Wait();
+  cl_ulong start = 0;
+  cl_ulong end = 0;
+  CL_CHECK(clGetEventProfilingInfo(event_.get(), CL_PROFILING_COMMAND_START, sizeof(start), &start,
+                                   nullptr));
+  CL_CHECK(
+      clGetEventProfilingInfo(event_.get(), CL_PROFILING_COMMAND_END, sizeof(end), &end, nullptr));
+  return end >= start ? end - start : 0;
+}
+
+ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags) : size_(bytes) {
+  if (bytes == 0) throw Error("cannot create an empty OpenCL buffer (0 bytes)");
+  if (bytes > context.device().max_alloc_bytes) {
+    throw Error("OpenCL buffer of " + std::to_string(bytes) + " bytes exceeds " +
+                context.device().name + "'s CL_DEVICE_MAX_MEM_ALLOC_SIZE of " +
+                std::to_string(context.device().max_alloc_bytes) + " bytes");
+  }
+  cl_int status = CL_SUCCESS;
+  mem_ =
+      internal::ClHandle<cl_mem>(clCreateBuffer(context.context(), flags, bytes, nullptr, &status));
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateBuffer", __FILE__, __LINE__, std::to_string(bytes) + " bytes");
+  }
+  CL_CHECK(clRetainCommandQueue(context.queue()));
+  queue_ = internal::ClHandle<cl_command_queue>(context.queue());
+}
+
+void ClBuffer::CheckRange(const char* what, size_t bytes, size_t offset) const {
+  if (!mem_) throw std::logic_error(std::string(what) + " on a default-constructed ClBuffer");
+  if (offset > size_ || bytes > size_ - offset) {
+    throw Error(std::string(what) + " of " + std::to_string(bytes) + " bytes at offset " +
+                std::to_string(offset) + " does not fit an OpenCL buffer of " +
+                std::to_string(size_) + " bytes");
+  }
+}
+
+void ClBuffer::Write(const void* host, size_t bytes, size_t offset) {
+  CheckRange("write", bytes, offset);
+  if (bytes == 0) return;  // A zero-size transfer is CL_INVALID_VALUE.
+  CL_CHECK(clEnqueueWriteBuffer(queue_.get(), mem_.get(), CL_TRUE, offset, bytes, host, 0, nullptr,
+                                nullptr));
+}
+
+void ClBuffer::Read(void* host, size_t bytes, size_t offset) const {
+  CheckRange("read", bytes, offset);
+  if (bytes == 0) return;
+  CL_CHECK(clEnqueueReadBuffer(queue_.get(), mem_.get(), CL_TRUE, offset, bytes, host, 0, nullptr,
+                               nullptr));
+}
+
+std::string NDRange::ToString() const {
+  std::string text = std::to_string(sizes[0]);
+  for (cl_uint d = 1; d < dims; ++d) text += "x" + std::to_string(sizes[d]);
+  return text;
+}
+
+// ---------------------------------------------------------------------------
+
+ClKernel::ClKernel(const ClProgram& program, const std::string& name)
+    : name_(name), program_name_(program.name()) {
+  cl_int status = CL_SUCCESS;
+  kernel_ = internal::ClHandle<cl_kernel>(clCreateKernel(program.get(), name.c_str(), &status));
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateKernel", __FILE__, __LINE__,
+                  "kernel \"" + name + "\" in program \"" + program.name() + "\"");
+  }
+  CL_CHECK(
+      clGetKernelInfo(kernel_.get(), CL_KERNEL_NUM_ARGS, sizeof(num_args_), &num_args_, nullptr));
+}
+
+void ClKernel::CheckArgCount(size_t count) const {
+  if (count != num_args_) {
+    throw std::logic_error("kernel " + name_ + " takes " + std::to_string(num_args_) +
+                           " arguments; SetArgs got " + std::to_string(count));
+  }
+}
+
+void ClKernel::SetRawArg(cl_uint index, size_t size, const void* value, const char* kind) {
+  const cl_int status = clSetKernelArg(kernel_.get(), index, size, value);
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clSetKernelArg", __FILE__, __LINE__,
+                  "argument " + std::to_string(index) + " (" + kind + ", " + std::to_string(size) +
+                      " bytes) of kernel " + name_ + " in program \"" + program_name_ + "\"");
+  }
+}
+
+size_t ClKernel::MaxWorkGroupSize(cl_device_id device) const {
+  size_t size = 0;
+  CL_CHECK(clGetKernelWorkGroupInfo(kernel_.get(), device, CL_KERNEL_WORK_GROUP_SIZE, sizeof(size),
+                                    &size, nullptr));
+  return size;
+}
+
+std::array<size_t, 3> ClKernel::RequiredWorkGroupSize(cl_device_id device) const {
+  std::array<size_t, 3> size{};
+  CL_CHECK(clGetKernelWorkGroupInfo(kernel_.get(), device, CL_KERNEL_COMPILE_WORK_GROUP_SIZE,
+                                    sizeof(size), size.data(), nullptr));
+  return size;
+}
+
+uint64_t ClKernel::LocalMemBytes(cl_device_id device) const {
+  cl_ulong bytes = 0;
+  CL_CHECK(clGetKernelWorkGroupInfo(kernel_.get(), device, CL_KERNEL_LOCAL_MEM_SIZE, sizeof(bytes),
+                                    &bytes, nullptr));
+  return bytes;
+}
+
+ClProgram::ClProgram(cl_context context, cl_device_id device, std::string name,
+                     std::string_view source, std::string options)
+    : name_(std::move(name)), options_(std::move(options)) {
+  const char* text = source.data();
+  const size_t length = source.size();
+  cl_int status = CL_SUCCESS;
+  program_ = internal::ClHandle<cl_program>(
+      clCreateProgramWithSource(context, 1, &text, &length, &status));
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateProgramWithSource", __FILE__, __LINE__, "program " + name_);
+  }
+  const cl_int build_status =
+      clBuildProgram(program_.get(), 1, &device, options_.c_str(), nullptr, nullptr);
+  size_t log_size = 0;
+  if (clGetProgramBuildInfo(program_.get(), device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &log_size) ==
+      CL_SUCCESS) {
+    std::string log(log_size, '\0');
+    if (clGetProgramBuildInfo(program_.get(), device, CL_PROGRAM_BUILD_LOG, log_size, log.data(),
+                              nullptr) == CL_SUCCESS) {
+      build_log_ = CleanInfoString(std::move(log));
+    }
+  }
+  if (build_status != CL_SUCCESS) {
+    throw ProgramBuildError(build_status, name_, options_, build_log_, __FILE__, __LINE__);
+  }
+}
+
+BuildOptions::BuildOptions(std::initializer_list<std::pair<std::string, std::string>> defines) {
+  for (const auto& [name, value] : defines) Define(name, value);
+}
+
+BuildOptions& BuildOptions::Define(const std::string& name, const std::string& value) {
+  const auto is_ident = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  };
+  if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0])) ||
+      !std::all_of(name.begin(), name.end(), is_ident)) {
+    throw std::invalid_argument("build define name \"" + name + "\" is not a C identifier");
+  }
+  const auto is_bad = [](char c) {
+    return std::isspace(static_cast<unsigned char>(c)) || c == '"' || c == '\'' || c == '\\';
+  };
+  if (value.empty() || std::any_of(value.begin(), value.end(), is_bad)) {
+    throw std::invalid_argument("build define " + name + "=\"" + value +
+                                "\" must be non-empty without spaces, quotes or backslashes");
+  }
+  defines_[name] = value;
+  return *this;
+}
+
+BuildOptions& BuildOptions::Define(const std::string& name, float value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.9g", static_cast<double>(value));
+  std::string literal(text);
+  // %g drops the point of whole numbers, and "15f" is not a C literal.
+  if (literal.find_first_of(".eEni") == std::string::npos) literal += ".0";
+  return Define(name, literal + "f");
+}
+
+std::string BuildOptions::Render() const {
+  // No -cl-fast-relaxed-math or -cl-finite-math-only: the kernels signal
+  // "no value" with NaN and test for it, which those flags may compile away.
+  std::string options = "-cl-std=CL1.2";
+  for (const auto& [name, value] : defines_) options += " -D " + name + "=" + value;
+  return options;
+}
+
+// ---------------------------------------------------------------------------
+
+ClContext::ClContext(const DeviceOptions& options)
+    : ClContext(SelectedDevice(options), options.profile) {}
+
+ClContext::ClContext(const DeviceInfo& device, bool profile)
+    : device_(device), profiling_(profile) {
+  if (device.id == nullptr || device.platform_id == nullptr) {
+    throw std::invalid_argument("ClContext needs a DeviceInfo from ListDevices()");
+  }
+  const cl_context_properties properties[] = {
+      CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(device.platform_id), 0};
+  cl_int status = CL_SUCCESS;
+  context_ = internal::ClHandle<cl_context>(
+      clCreateContext(properties, 1, &device.id, nullptr, nullptr, &status));
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateContext", __FILE__, __LINE__, "device " + device.Describe());
+  }
+  const cl_command_queue_properties queue_properties = profile ? CL_QUEUE_PROFILING_ENABLE : 0;
+  queue_ = internal::ClHandle<cl_command_queue>(
+      clCreateCommandQueue(context_.get(), device.id, queue_properties, &status));
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateCommandQueue", __FILE__, __LINE__,
+                  "device " + device.Describe());
+  }
+}
+
+ClContext::~ClContext() { Release(); }
+
+ClContext& ClContext::operator=(ClContext&& other) noexcept {
+  if (this != &other) {
+    Release();
+    device_ = std::move(other.device_);
+    profiling_ = other.profiling_;
+    context_ = std::move(other.context_);
+    queue_ = std::move(other.queue_);
+    programs_ = std::move(other.programs_);
+  }
+  return *this;
+}
+
+void ClContext::Release() noexcept {
+  if (queue_) {
+    const cl_int status = clFinish(queue_.get());
+    if (status != CL_SUCCESS) internal::LogClFailure(status, "clFinish", __FILE__, __LINE__);
+  }
+  programs_.clear();
+  queue_.Reset();
+  context_.Reset();
+}
+
+const ClProgram& ClContext::Program(std::string_view kernel_file, const BuildOptions& defines) {
+  return CachedProgram(kernel_file, defines, std::nullopt);
+}
+
+const ClProgram& ClContext::ProgramFromSource(std::string_view name, std::string_view source,
+                                              const BuildOptions& defines) {
+  return CachedProgram(name, defines, source);
+}
+
+const ClProgram& ClContext::CachedProgram(std::string_view name, const BuildOptions& defines,
+                                          std::optional<std::string_view> source) {
+  CacheKey key{device_.id, std::string(name), defines.Render()};
+  if (const auto it = programs_.find(key); it != programs_.end()) {
+    if (source && std::hash<std::string_view>{}(*source) != it->second.source_hash) {
+      throw std::logic_error("OpenCL program name \"" + std::string(name) +
+                             "\" reused for a different source");
+    }
+    return *it->second.program;
+  }
+  std::string loaded;
+  if (!source) {
+    loaded = ProgramSource(name);
+    source = loaded;
+  }
+  CacheEntry entry;
+  entry.source_hash = std::hash<std::string_view>{}(*source);
+  entry.program = std::make_unique<ClProgram>(context_.get(), device_.id, std::get<1>(key), *source,
+                                              std::get<2>(key));
+  return *programs_.emplace(std::move(key), std::move(entry)).first->second.program;
+}
+
+ClEvent ClContext::Enqueue(const ClKernel& kernel, const NDRange& global, const NDRange& local) {
+  if (kernel.get() == nullptr) throw std::logic_error("Enqueue of a default-constructed ClKernel");
+  const std::string context = LaunchContext(kernel, device_);
+  if (global.dims != local.dims) {
+    throw Error(context + "global size " + global.ToString() + " and work-group size " +
+                local.ToString() + " differ in dimensions");
+  }
+  if (local.Total() > device_.max_work_group_size) {
+    throw Error(context + "work-group size " + local.ToString() + " (" +
+                std::to_string(local.Total()) +
+                " work-items) exceeds the device's CL_DEVICE_MAX_WORK_GROUP_SIZE of " +
+                std::to_string(device_.max_work_group_size));
+  }
+  for (cl_uint d = 0; d < local.dims; ++d) {
+    if (global.sizes[d] == 0 || local.sizes[d] == 0) {
+      throw Error(context + "empty global size " + global.ToString() + " or work-group size " +
+                  local.ToString());
+    }
+    if (d >= device_.max_work_item_sizes.size() ||
+        local.sizes[d] > device_.max_work_item_sizes[d]) {
+      throw Error(context + "work-group size " + local.ToString() + " exceeds the device's " +
+                  "CL_DEVICE_MAX_WORK_ITEM_SIZES in dimension " + std::to_string(d));
+    }
+  }
+  if (const size_t kernel_max = kernel.MaxWorkGroupSize(device_.id); local.Total() > kernel_max) {
+    throw Error(context + "work-group size " + local.ToString() + " (" +
+                std::to_string(local.Total()) +
+                " work-items) exceeds this kernel's CL_KERNEL_WORK_GROUP_SIZE of " +
+                std::to_string(kernel_max) + " on this device");
+  }
+  if (const auto required = kernel.RequiredWorkGroupSize(device_.id); required[0] != 0) {
+    for (cl_uint d = 0; d < 3; ++d) {
+      if (local.sizes[d] != required[d]) {
+        throw Error(context + "work-group size " + local.ToString() +
+                    " differs from the kernel's reqd_work_group_size " +
+                    NDRange(required[0], required[1], required[2]).ToString() +
+                    " it was built for");
+      }
+    }
+  }
+  if (const uint64_t bytes = kernel.LocalMemBytes(device_.id); bytes > device_.local_mem_bytes) {
+    throw Error(context + "needs " + std::to_string(bytes) +
+                " bytes of local memory; the device has " +
+                std::to_string(device_.local_mem_bytes));
+  }
+
+  NDRange rounded = global;
+  for (cl_uint d = 0; d < global.dims; ++d) {
+    rounded.sizes[d] = (global.sizes[d] + local.sizes[d] - 1) / local.sizes[d] * local.sizes[d];
+  }
+  cl_event event = nullptr;
+  const cl_int status =
+      clEnqueueNDRangeKernel(queue_.get(), kernel.get(), global.dims, nullptr, rounded.sizes.data(),
+                             local.sizes.data(), 0, nullptr, &event);
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clEnqueueNDRangeKernel", __FILE__, __LINE__,
+                  "kernel " + kernel.name() + ", global " + rounded.ToString() + ", local " +
+                      local.ToString());
+  }
+  return ClEvent(event, profiling_);
+}
+
+void ClContext::Finish() const { CL_CHECK(clFinish(queue_.get())); }
+
+}  // namespace sapmvs

@@ -1,0 +1,404 @@
+#pragma once
+// The OpenCL runtime layer: device discovery and selection, one context with
+// one in-order queue, thin RAII wrappers over the C API (movable, not
+// copyable, in the manner of CLBlast's clpp11) and a program cache. Every
+// kernel launch goes through ClContext::Enqueue, which checks work-group
+// limits first so a bad launch fails with a sentence rather than
+// CL_INVALID_WORK_GROUP_SIZE.
+//
+// Nothing here is thread-safe: use one ClContext per host thread.
+
+#include <CL/cl.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "device/cl_error.h"
+#include "match/device_spec.h"
+
+namespace sapmvs {
+
+// ---------------------------------------------------------------------------
+// Devices.
+
+enum class DeviceType { kGpu, kCpu, kOther };
+
+// "GPU", "CPU" or "other".
+const char* DeviceTypeName(DeviceType type);
+
+struct DeviceInfo {
+  int platform_index = -1;  // Position in clGetPlatformIDs' list.
+  std::string platform_name;
+  std::string platform_version;  // CL_PLATFORM_VERSION, e.g. "OpenCL 3.0 PoCL 3.1".
+  int index = -1;                // Position in ListDevices(); what `--device N` means.
+  std::string name;
+  std::string vendor;
+  DeviceType type = DeviceType::kOther;
+  bool available = false;                   // CL_DEVICE_AVAILABLE and a compiler present.
+  uint64_t global_mem_bytes = 0;            // CL_DEVICE_GLOBAL_MEM_SIZE.
+  uint64_t max_alloc_bytes = 0;             // CL_DEVICE_MAX_MEM_ALLOC_SIZE: largest buffer.
+  uint64_t local_mem_bytes = 0;             // CL_DEVICE_LOCAL_MEM_SIZE: per work-group.
+  int compute_units = 0;                    // CL_DEVICE_MAX_COMPUTE_UNITS.
+  size_t max_work_group_size = 0;           // CL_DEVICE_MAX_WORK_GROUP_SIZE, work-items.
+  std::vector<size_t> max_work_item_sizes;  // Per dimension, work-items.
+  bool image_support = false;
+  std::string version;           // CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ...".
+  std::string opencl_c_version;  // CL_DEVICE_OPENCL_C_VERSION, e.g. "OpenCL C 1.2 PoCL".
+  cl_platform_id platform_id = nullptr;
+  cl_device_id id = nullptr;
+
+  // The PoCL CPU device, our reference device and CPU fallback.
+  bool IsPoclCpu() const;
+  // What a `--device` substring is matched against: platform name and version
+  // (which is where "PoCL" and NVIDIA's "CUDA" appear), device name, vendor.
+  std::string MatchText() const;
+  // One-line description for messages: "0: Portable Computing Language / <name> (CPU)".
+  std::string Describe() const;
+};
+
+// "3.0" from "OpenCL 3.0 PoCL ..." or "1.2" from "OpenCL C 1.2 ..."; the input
+// unchanged when it does not have that form.
+std::string ShortClVersion(const std::string& version);
+
+// All devices of all platforms, platform by platform, in driver order. Throws
+// NoDeviceError when there is no platform or no device at all.
+std::vector<DeviceInfo> ListDevices();
+
+struct DeviceOptions {
+  // Which device to use. "" = SAPMVS_DEVICE from the environment if set, else
+  // the default (first GPU, else the PoCL CPU device, else the first device).
+  // Otherwise an index into ListDevices() or a case-insensitive substring of
+  // DeviceInfo::MatchText(), i.e. platform name/version + device name + vendor
+  // (first match wins), e.g. "pocl", "nvidia", "cuda".
+  std::string device;
+  // Create the queue with CL_QUEUE_PROFILING_ENABLE so ClEvent::DeviceTimeNs()
+  // works. Costs a little per launch on some drivers.
+  bool profile = false;
+
+  // False for a spec that can never match: a negative index or control
+  // characters.
+  bool Check() const;
+};
+
+// The device spec in effect and where it came from (device_spec.h).
+DeviceSpec EffectiveDeviceSpec(const DeviceOptions& options);
+
+// Index into `devices` of the default device (see DeviceOptions::device).
+int DefaultDeviceIndex(const std::vector<DeviceInfo>& devices);
+
+// Index into `devices` of the device `options` selects. Throws NoDeviceError
+// naming the spec and listing the devices when nothing matches.
+int SelectDeviceIndex(const std::vector<DeviceInfo>& devices, const DeviceOptions& options);
+
+// ---------------------------------------------------------------------------
+// RAII handles.
+
+namespace internal {
+
+template <typename T>
+struct ClTraits;
+
+#define SAPMVS_CL_TRAITS(type, release)                   \
+  template <>                                             \
+  struct ClTraits<type> {                                 \
+    static cl_int Release(type h) { return release(h); }  \
+    static constexpr const char* kReleaseName = #release; \
+  }
+SAPMVS_CL_TRAITS(cl_context, clReleaseContext);
+SAPMVS_CL_TRAITS(cl_command_queue, clReleaseCommandQueue);
+SAPMVS_CL_TRAITS(cl_mem, clReleaseMemObject);
+SAPMVS_CL_TRAITS(cl_program, clReleaseProgram);
+SAPMVS_CL_TRAITS(cl_kernel, clReleaseKernel);
+SAPMVS_CL_TRAITS(cl_event, clReleaseEvent);
+#undef SAPMVS_CL_TRAITS
+
+// Owns one reference to an OpenCL object.
+template <typename T>
+class ClHandle {
+ public:
+  ClHandle() = default;
+  explicit ClHandle(T handle) : handle_(handle) {}
+  ~ClHandle() { Reset(); }
+  ClHandle(const ClHandle&) = delete;
+  ClHandle& operator=(const ClHandle&) = delete;
+  ClHandle(ClHandle&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+  ClHandle& operator=(ClHandle&& other) noexcept {
+    if (this != &other) {
+      Reset();
+      handle_ = std::exchange(other.handle_, nullptr);
+    }
+    return *this;
+  }
+
+  T get() const { return handle_; }
+  explicit operator bool() const { return handle_ != nullptr; }
+
+  void Reset() noexcept {
+    if (handle_ == nullptr) return;
+    const cl_int status = ClTraits<T>::Release(handle_);
+    if (status != CL_SUCCESS) {
+      LogClFailure(status, ClTraits<T>::kReleaseName, __FILE__, __LINE__);
+    }
+    handle_ = nullptr;
+  }
+
+ private:
+  T handle_ = nullptr;
+};
+
+}  // namespace internal
+
+class ClContext;
+class ClProgram;
+
+// A completed or pending command.
+class ClEvent {
+ public:
+  ClEvent() = default;
+  // Takes ownership of `event`. `profiling` tells whether its queue profiles.
+  ClEvent(cl_event event, bool profiling) : event_(event), profiling_(profiling) {}
+
+  cl_event get() const { return event_.get(); }
+  bool profiling() const { return profiling_; }
+  void Wait() const;
+  // Device execution time (CL_PROFILING_COMMAND_END - START) in nanoseconds;
+  // waits for the command first. Throws Error unless the context was created
+  // with DeviceOptions::profile.
+  uint64_t DeviceTimeNs() const;
+
+ private:
+  internal::ClHandle<cl_event> event_;
+  bool profiling_ = false;
+};
+
+// A device buffer. Write/Read are blocking and go through the context's queue
+// (the buffer keeps its own reference to it).
+class ClBuffer {
+ public:
+  ClBuffer() = default;
+  // Throws Error for 0 bytes or more than the device's max allocation.
+  ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE);
+
+  cl_mem get() const { return mem_.get(); }
+  size_t size() const { return size_; }  // Bytes.
+
+  // Copy `bytes` between host memory and [offset, offset + bytes) of the
+  // buffer. Throws Error when the range does not fit.
+  void Write(const void* host, size_t bytes, size_t offset = 0);
+  void Read(void* host, size_t bytes, size_t offset = 0) const;
+
+  // Typed helpers; `offset` is in bytes. ReadVector reads values->size()
+  // elements. (Named apart from Write/Read so `Read(&v, n)` cannot silently
+  // mean "n bytes" to one reader and "offset n" to another.)
+  template <typename T>
+  void WriteVector(const std::vector<T>& values, size_t offset = 0) {
+    static_assert(std::is_trivially_copyable_v<T>, "buffer elements must be trivially copyable");
+    Write(values.data(), values.size() * sizeof(T), offset);
+  }
+  template <typename T>
+  void ReadVector(std::vector<T>* values, size_t offset = 0) const {
+    static_assert(std::is_trivially_copyable_v<T>, "buffer elements must be trivially copyable");
+    Read(values->data(), values->size() * sizeof(T), offset);
+  }
+
+ private:
+  void CheckRange(const char* what, size_t bytes, size_t offset) const;
+
+  internal::ClHandle<cl_mem> mem_;
+  internal::ClHandle<cl_command_queue> queue_;
+  size_t size_ = 0;
+};
+
+// A `__local` kernel argument of `bytes` bytes, for ClKernel::SetArgs.
+struct LocalMem {
+  size_t bytes = 0;
+};
+
+// A launch size of 1 to 3 dimensions, in work-items. Implicit from one size_t
+// so 1-D launches read `Enqueue(kernel, n, 64)`.
+struct NDRange {
+  NDRange(size_t x) : dims(1), sizes{x, 1, 1} {}  // NOLINT(runtime/explicit)
+  NDRange(size_t x, size_t y) : dims(2), sizes{x, y, 1} {}
+  NDRange(size_t x, size_t y, size_t z) : dims(3), sizes{x, y, z} {}
+
+  size_t Total() const { return sizes[0] * sizes[1] * sizes[2]; }
+  std::string ToString() const;  // "64" or "16x16".
+
+  cl_uint dims;
+  std::array<size_t, 3> sizes;
+};
+
+class ClKernel {
+ public:
+  ClKernel() = default;
+  // Throws ClError (CL_INVALID_KERNEL_NAME) naming the kernel and program.
+  ClKernel(const ClProgram& program, const std::string& name);
+
+  cl_kernel get() const { return kernel_.get(); }
+  const std::string& name() const { return name_; }
+  cl_uint num_args() const { return num_args_; }
+
+  // Sets all arguments in order. Each is a ClBuffer, a LocalMem or a trivially
+  // copyable scalar/vector (cl_int, cl_float, cl_float2, ...) whose size must
+  // match the kernel's parameter; a mismatch throws naming the argument.
+  template <typename... Args>
+  void SetArgs(const Args&... args) {
+    CheckArgCount(sizeof...(Args));
+    cl_uint index = 0;
+    (SetArg(index++, args), ...);
+  }
+
+  template <typename T>
+  void SetArg(cl_uint index, const T& value) {
+    if constexpr (std::is_same_v<T, ClBuffer>) {
+      const cl_mem mem = value.get();
+      SetRawArg(index, sizeof(cl_mem), &mem, "buffer");
+    } else if constexpr (std::is_same_v<T, LocalMem>) {
+      SetRawArg(index, value.bytes, nullptr, "local memory");
+    } else {
+      static_assert(std::is_trivially_copyable_v<T> && !std::is_pointer_v<T>,
+                    "kernel arguments are ClBuffer, LocalMem or plain values");
+      static_assert(!std::is_same_v<T, bool>, "bool is not a valid OpenCL kernel argument");
+      SetRawArg(index, sizeof(T), &value, "value");
+    }
+  }
+
+  // CL_KERNEL_WORK_GROUP_SIZE: the largest work-group this kernel can run
+  // with on `device` (may be below the device maximum, e.g. register use).
+  size_t MaxWorkGroupSize(cl_device_id device) const;
+  // The kernel's reqd_work_group_size attribute, or {0, 0, 0} without one.
+  std::array<size_t, 3> RequiredWorkGroupSize(cl_device_id device) const;
+  // CL_KERNEL_LOCAL_MEM_SIZE in bytes, including LocalMem arguments set so far.
+  uint64_t LocalMemBytes(cl_device_id device) const;
+
+ private:
+  void CheckArgCount(size_t count) const;
+  void SetRawArg(cl_uint index, size_t size, const void* value, const char* kind);
+
+  internal::ClHandle<cl_kernel> kernel_;
+  std::string name_;
+  std::string program_name_;
+  cl_uint num_args_ = 0;
+};
+
+// A built program. Obtain through ClContext::Program so builds are cached.
+class ClProgram {
+ public:
+  // Builds `source` for `device`; throws ProgramBuildError with the full log.
+  ClProgram(cl_context context, cl_device_id device, std::string name, std::string_view source,
+            std::string options);
+
+  cl_program get() const { return program_.get(); }
+  const std::string& name() const { return name_; }
+  const std::string& options() const { return options_; }
+  const std::string& build_log() const { return build_log_; }  // Warnings, if any.
+
+  ClKernel Kernel(const std::string& kernel_name) const { return ClKernel(*this, kernel_name); }
+
+ private:
+  internal::ClHandle<cl_program> program_;
+  std::string name_;
+  std::string options_;
+  std::string build_log_;
+};
+
+// `-D NAME=VALUE` defines for a program build, rendered sorted by name so
+// equal sets give equal option strings (and so hit the same cache entry).
+class BuildOptions {
+ public:
+  BuildOptions() = default;
+  BuildOptions(std::initializer_list<std::pair<std::string, std::string>> defines);
+
+  // Throws std::invalid_argument unless `name` is a C identifier and `value`
+  // is non-empty without whitespace or quotes (options are split on spaces).
+  BuildOptions& Define(const std::string& name, const std::string& value);
+  template <typename T, typename = std::enable_if_t<std::is_integral_v<T>>>
+  BuildOptions& Define(const std::string& name, T value) {
+    return Define(name, std::to_string(value));
+  }
+  // A float literal that parses back to exactly `value` in OpenCL C
+  // ("%.9gf": 9 significant digits round-trip every float).
+  BuildOptions& Define(const std::string& name, float value);
+
+  const std::map<std::string, std::string>& defines() const { return defines_; }
+  // The complete option string: "-cl-std=CL1.2 -D A=1 -D B=2".
+  std::string Render() const;
+
+ private:
+  std::map<std::string, std::string> defines_;
+};
+
+// The selected device's context and its single in-order queue, plus the
+// program cache. Movable; programs handed out stay valid while it lives.
+class ClContext {
+ public:
+  // Selects a device as described in DeviceOptions. Throws NoDeviceError.
+  explicit ClContext(const DeviceOptions& options = DeviceOptions());
+  ClContext(const DeviceInfo& device, bool profile);
+  // Waits for the queue (Finish) before releasing the programs, the queue and
+  // the context, in that order. A command still in flight at release can
+  // leave a driver thread working (PoCL compiles a kernel's work-group
+  // function when it first runs) while the process exits and tears down the
+  // compiler under it.
+  ~ClContext();
+  ClContext(ClContext&& other) noexcept = default;
+  ClContext& operator=(ClContext&& other) noexcept;
+  ClContext(const ClContext&) = delete;
+  ClContext& operator=(const ClContext&) = delete;
+
+  const DeviceInfo& device() const { return device_; }
+  cl_device_id device_id() const { return device_.id; }
+  cl_context context() const { return context_.get(); }
+  cl_command_queue queue() const { return queue_.get(); }
+  bool profiling() const { return profiling_; }
+
+  // The program built from kernels/<kernel_file> (see KernelSource) with
+  // `defines`; built on first use, then cached by (device, name, options).
+  const ClProgram& Program(std::string_view kernel_file, const BuildOptions& defines = {});
+  // Same, from a source string (tests, generated code). `name` must identify
+  // the source: reusing it with different source for the same options throws
+  // std::logic_error rather than returning a stale program.
+  const ClProgram& ProgramFromSource(std::string_view name, std::string_view source,
+                                     const BuildOptions& defines = {});
+  size_t NumCachedPrograms() const { return programs_.size(); }
+
+  // The one launch path. Checks `local` against the device and the kernel
+  // (work-group size, work-item sizes, reqd_work_group_size, local memory) and
+  // throws Error before enqueueing if it cannot run; rounds `global` up to a
+  // multiple of `local`, so the kernel must bounds-check its global id.
+  ClEvent Enqueue(const ClKernel& kernel, const NDRange& global, const NDRange& local);
+
+  // Blocks until every queued command has finished.
+  void Finish() const;
+
+ private:
+  using CacheKey = std::tuple<cl_device_id, std::string, std::string>;
+  struct CacheEntry {
+    size_t source_hash = 0;
+    std::unique_ptr<ClProgram> program;
+  };
+  // `source` empty: load kernels/<name> on a cache miss.
+  const ClProgram& CachedProgram(std::string_view name, const BuildOptions& defines,
+                                 std::optional<std::string_view> source);
+  // Finish, then release in order; leaves the object empty. Never throws.
+  void Release() noexcept;
+
+  DeviceInfo device_;
+  bool profiling_ = false;
+  internal::ClHandle<cl_context> context_;
+  internal::ClHandle<cl_command_queue> queue_;
+  std::map<CacheKey, CacheEntry> programs_;
+};
+
+}  // namespace sapmvs

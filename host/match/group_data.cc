@@ -1,0 +1,131 @@
+#include "match/group_data.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/image_io.h"
+#include "sapmvs/match/matcher_options.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/kernel_limits.h"
+
+namespace sapmvs {
+
+double TriangulationAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                             const Eigen::Vector3d& x) {
+  const Eigen::Vector3d ra = (a - x).normalized();
+  const Eigen::Vector3d rb = (b - x).normalized();
+  return std::acos(std::clamp(ra.dot(rb), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
+                              const BlockGeometry* known_geometry) {
+  MatchGroupData group;
+  group.origin = block.origin;
+  const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
+  std::vector<double> valid_depths;
+  for (const int id : ids) {
+    if (geometry.images.size() > static_cast<size_t>(id) && geometry.images[id].valid) {
+      valid_depths.push_back(geometry.images[id].depth);
+    }
+  }
+  double fallback_depth = 0;
+  if (!valid_depths.empty()) {
+    std::nth_element(valid_depths.begin(), valid_depths.begin() + valid_depths.size() / 2,
+                     valid_depths.end());
+    fallback_depth = valid_depths[valid_depths.size() / 2];
+  }
+  const double scale = std::ldexp(1.0, -level);
+  std::vector<double> gsds;
+  for (const int id : ids) {
+    const BlockImage& bi = block.images.at(id);
+    LoadedImage loaded = LoadUndistorted(bi);
+    MatchImage im;
+    im.name = bi.name;
+    im.block_index = id;
+    im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
+    const cv::Mat bgr =
+        ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
+    im.color = bgr;
+    cv::Mat grey8;
+    cv::cvtColor(bgr, grey8, cv::COLOR_BGR2GRAY);
+    grey8.convertTo(im.grey, CV_32F);
+    const bool have = geometry.images.size() > static_cast<size_t>(id) && geometry.images[id].valid;
+    im.depth = have ? geometry.images[id].depth : fallback_depth;
+    if (im.depth > 0) gsds.push_back(im.depth / im.camera.intrinsics().MeanFocal());
+    group.images.push_back(std::move(im));
+  }
+  if (group.images.size() < 2)
+    throw Error("matching needs at least 2 images, got " + std::to_string(group.images.size()));
+  if (!gsds.empty()) {
+    std::nth_element(gsds.begin(), gsds.begin() + gsds.size() / 2, gsds.end());
+    group.gsd = gsds[gsds.size() / 2];
+  }
+  for (const MatchImage& im : group.images) {
+    FloatImageView view;
+    view.data = im.grey.ptr<float>();
+    view.layout.width = im.grey.cols;
+    view.layout.height = im.grey.rows;
+    view.layout.row_pitch = static_cast<int>(im.grey.step1());
+    group.ncc.images.push_back(view);
+    group.ncc.cameras.push_back(MakeNccCamera(im.camera, im.name.c_str()));
+  }
+  return group;
+}
+
+void SelectViews(const MatcherOptions& /*options*/, MatchGroupData* group) {
+  // Below this, a view is a copy of the reference's viewpoint.
+  constexpr double kMinViewAngleDeg = 0.1;
+  auto& images = group->images;
+  // Without any surface estimate, fall back on a depth that gives the
+  // neighbours a plausible baseline: the median distance to the nearest centre
+  // times 2.5 (60 % overlap of a nadir block).
+  for (MatchImage& im : images) {
+    if (im.depth > 0) continue;
+    double nearest = 1e300;
+    for (const MatchImage& other : images) {
+      if (&other == &im) continue;
+      nearest = std::min(nearest, (other.camera.center() - im.camera.center()).norm());
+    }
+    im.depth = 2.5 * nearest;
+  }
+  constexpr int kGrid = 7;
+  for (size_t i = 0; i < images.size(); ++i) {
+    MatchImage& im = images[i];
+    const Camera& cam = im.camera;
+    const Eigen::Vector3d axis_point = cam.BackProject(
+        Eigen::Vector2d(0.5 * (cam.width() - 1), 0.5 * (cam.height() - 1)), im.depth);
+    std::vector<std::pair<double, int>> ranked;
+    for (size_t j = 0; j < images.size(); ++j) {
+      if (j == i) continue;
+      const Camera& other = images[j].camera;
+      // A view from (almost) the same place adds no depth; narrow views do,
+      // together with the others (PatchEngine::WideEnough), so they stay.
+      if (TriangulationAngleDeg(cam.center(), other.center(), axis_point) < kMinViewAngleDeg) {
+        continue;
+      }
+      int inside = 0;
+      for (int gy = 0; gy < kGrid; ++gy) {
+        for (int gx = 0; gx < kGrid; ++gx) {
+          const Eigen::Vector2d uv((gx + 0.5) * cam.width() / kGrid,
+                                   (gy + 0.5) * cam.height() / kGrid);
+          const Eigen::Vector3d x = cam.BackProject(uv, im.depth);
+          if (other.Depth(x) > 0 && other.InImage(other.Project(x))) ++inside;
+        }
+      }
+      const double overlap = static_cast<double>(inside) / (kGrid * kGrid);
+      if (overlap >= 0.1) ranked.emplace_back(overlap, static_cast<int>(j));
+    }
+    std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    im.views.clear();
+    for (const auto& r : ranked) {
+      if (static_cast<int>(im.views.size()) >= kMaxViews - 1) break;
+      im.views.push_back(r.second);
+    }
+  }
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,55 @@
+#pragma once
+// One group of images prepared for matching: pixels at the working pyramid
+// level, pinhole cameras in the block's local frame, the views each image is
+// matched with, and the depth range its scene is expected in.
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "match/patch_kernel_types.h"
+#include "sapmvs/block/block.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/camera.h"
+
+namespace sapmvs {
+
+struct MatcherOptions;
+
+struct MatchImage {
+  std::string name;
+  int block_index = -1;
+  Camera camera;           // local frame, working level, no distortion
+  cv::Mat grey;            // CV_32F, grey levels 0..255
+  cv::Mat color;           // CV_8UC3, BGR
+  std::vector<int> views;  // other images of the group to match with, best first
+  double depth = 0;        // expected scene depth along the optical axis
+};
+
+struct MatchGroupData {
+  std::vector<MatchImage> images;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  double gsd = 0;  // median footprint of a working pixel at the expected depth
+  NccGroup ncc;    // views of `images` for the patch kernels (valid while images live)
+};
+
+// Loads (undistorted) images `ids` of `block` and reduces them to `level`
+// with 2x2 area averaging, so pixel centres stay where Camera::Scaled puts
+// them. Throws Error naming the image for unreadable files.
+// `geometry`: EstimateBlockGeometry(block) when the caller has it (a
+// whole-block run loads many groups of one block; estimating it reads the
+// block's DEM each time), else nullptr and it is estimated here.
+MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
+                              const BlockGeometry* geometry = nullptr);
+
+// Picks each image's views: images whose footprint overlaps its own at the
+// expected depth, most overlap first, at most kMaxViews - 1. As in PMVS2,
+// views narrower than max_angle_deg take part: the angle condition applies
+// to the views a patch is matched in (PatchEngine), not to each view.
+void SelectViews(const MatcherOptions& options, MatchGroupData* group);
+
+// Angle, degrees, between the rays from camera centres a and b to x.
+double TriangulationAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                             const Eigen::Vector3d& x);
+
+}  // namespace sapmvs

@@ -1,0 +1,219 @@
+#include "sapmvs/match/match_group.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include "match/edge_matcher.h"
+#include "match/feature_detector.h"
+#include "match/group_data.h"
+#include "match/patch_engine.h"
+#include "match/patch_filter.h"
+#include "match/propagation.h"
+#include "match/seed_matcher.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/memory_use.h"
+#include "sapmvs/util/progress.h"
+#include "util/run_progress.h"
+
+namespace sapmvs {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double DeviceSeconds(const PatchEngine& engine) {
+  double s = 0;
+  for (const auto& [name, t] : engine.kernel_times()) s += t.seconds;
+  return s;
+}
+
+}  // namespace
+
+MatcherMemoryModel MatcherMemory() {
+  const double views = kMaxViews - 1;
+  const KernelBatchBytes batch = PatchKernelBatchBytes();
+  MatcherMemoryModel m;
+  // grouping.h EstimateGroupMemory spells out each term.
+  m.device_bytes_per_pixel = 8;
+  m.host_bytes_per_pixel = 20;
+  m.host_bytes_per_cell =
+      4 + 1 + 3 * sizeof(float) + sizeof(AcceptedPatch) + 4 * views + sizeof(DensePoint);
+  m.device_bytes_per_candidate = batch.per_patch + views * batch.per_pair;
+  m.host_bytes_per_candidate =
+      sizeof(PatchCandidate) + sizeof(std::optional<AcceptedPatch>) + 4 * views;
+  return m;
+}
+
+MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
+                       const MatcherOptions& options, PatchKernels& kernels,
+                       const BlockGeometry* geometry, const MatchProgressFn& on_progress) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("matcher options: expected " + problem);
+  std::vector<int> ids = image_ids;
+  if (ids.empty()) {
+    for (size_t i = 0; i < block.images.size(); ++i) ids.push_back(static_cast<int>(i));
+  }
+  MatchResult result;
+  MatchStats& stats = result.stats;
+  // Without a caller's display, a one-group status line of our own.
+  std::optional<RunProgress> own;
+  if (!on_progress && options.progress && Progress::TerminalAllowsProgress()) {
+    own.emplace(1, static_cast<long>(ids.size()), true);
+    own->StartGroup(0, 1, static_cast<long>(ids.size()));
+  }
+  auto report = [&](const std::string& stage, long done = 0, long total = 0,
+                    const std::string& detail = "") {
+    const MatchProgressEvent e{stage, done, total, detail};
+    if (on_progress) on_progress(e);
+    if (own) own->Update(e);
+  };
+  report("load");
+  auto stage_start = std::chrono::steady_clock::now();
+  double device_before = 0;
+  const PatchEngine* engine_ptr = nullptr;
+  auto end_stage = [&](const std::string& name) {
+    StageTime t;
+    t.wall = Seconds(stage_start);
+    const double device_now = engine_ptr ? DeviceSeconds(*engine_ptr) : 0;
+    t.device = device_now - device_before;
+    t.peak_rss_bytes = PeakRssBytes();
+    device_before = device_now;
+    // Stages repeated by the expand-filter passes add up under one name.
+    auto same = std::find_if(stats.stages.begin(), stats.stages.end(),
+                             [&](const auto& s) { return s.first == name; });
+    if (same == stats.stages.end()) {
+      stats.stages.emplace_back(name, t);
+    } else {
+      same->second.wall += t.wall;
+      same->second.device += t.device;
+      same->second.peak_rss_bytes = t.peak_rss_bytes;
+    }
+    stage_start = std::chrono::steady_clock::now();
+  };
+
+  MatchGroupData group = LoadMatchGroup(block, ids, options.level, geometry);
+  SelectViews(options, &group);
+  stats.images = static_cast<int>(group.images.size());
+  stats.gsd = group.gsd;
+  end_stage("load");
+  report("features");
+
+  const int largest = options.mode == MatchMode::kSapmvs
+                          ? std::max(options.window_size, options.adaptive_sizes.front())
+                          : options.window_size;
+  const int margin = largest / 2 + 1;
+  std::vector<std::vector<Feature>> features(group.images.size());
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    features[i] = DetectFeatures(group.images[i].grey, options.features_per_block, margin);
+    stats.features += static_cast<long>(features[i].size());
+  }
+  end_stage("features");
+
+  report("seeds", 0, 0, "epipolar candidates");
+  const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  report("seeds", 0, 0, "building kernels");
+  PatchEngine engine(kernels, group, options);
+  engine_ptr = &engine;
+  Propagator propagator(group, options, engine);
+  propagator.RunSeeds(seeds, [&](long rank, long ranks, long accepted) {
+    report("seeds", rank, ranks, std::to_string(accepted) + " accepted");
+  });
+  stats.seeds_tried = propagator.seeds_tried();
+  stats.seeds_accepted = propagator.seeds_accepted();
+  end_stage("seeds");
+
+  // Per image, the depths its accepted seeds span (5th to 95th percentile),
+  // padded by `share` of that span plus `gsds` ground sample distances;
+  // (0, 0) when an image has fewer than 10 seeds.
+  auto seed_depth_ranges = [&](double share, double gsds) {
+    std::vector<std::pair<double, double>> ranges(group.images.size(), {0.0, 0.0});
+    for (size_t i = 0; i < group.images.size(); ++i) {
+      std::vector<double> d = propagator.seed_depths()[i];
+      if (d.size() < 10) continue;
+      std::sort(d.begin(), d.end());
+      const double lo = d[d.size() / 20], hi = d[d.size() - 1 - d.size() / 20];
+      const double pad = share * (hi - lo) + gsds * group.gsd;
+      ranges[i] = {lo - pad, hi + pad};
+    }
+    return ranges;
+  };
+  if (options.mode == MatchMode::kSapmvs && options.use_edges) {
+    report("edges");
+    const auto ranges = seed_depth_ranges(0.25, 2.0);
+    EdgeMatchStats es;
+    propagator.SetEdges(MatchEdges(group, options, ranges, engine, &es));
+    stats.edge_points = es.edge_pixels;
+    stats.matched_edge_points = es.matched;
+    end_stage("edges");
+  }
+
+  const std::vector<std::pair<double, double>> plausible =
+      SeedDepthFences(propagator.seed_depths(), group.gsd);
+  const auto& points = propagator.points();
+  const auto& patches = propagator.patches();
+  std::vector<bool> keep;
+  // PMVS's loop: expand, filter, and expand again into the ground the
+  // filter freed; every pass filters all points, old and new.
+  for (int pass = 0; pass < options.expand_iterations; ++pass) {
+    if (pass > 0) propagator.Prune(keep);
+    propagator.RunWaves([&](long wave, long size, long emitted) {
+      report("propagation", pass + 1, options.expand_iterations,
+             "wave " + std::to_string(wave) + ", " + std::to_string(size) + " candidates, " +
+                 std::to_string(emitted) + " points");
+    });
+    end_stage("propagation");
+    report("filter", pass + 1, options.expand_iterations);
+
+    // The fence, from the scores of the points of the first expansion.
+    if (pass == 0) stats.score_floor = ScoreFloor(options, points, patches);
+    MatchStats removed;
+    keep = FilterPoints(group, options, points, patches, &removed, stats.score_floor);
+    stats.removed_depth_range += ApplyDepthFences(group, points, patches, plausible, &keep);
+    stats.removed_score += removed.removed_score;
+    stats.plane_tolerance = removed.plane_tolerance;
+    stats.removed_visibility += removed.removed_visibility;
+    stats.removed_neighbourhood += removed.removed_neighbourhood;
+    stats.removed_clusters += removed.removed_clusters;
+    end_stage("filter");
+  }
+  stats.candidates = propagator.candidates();
+  stats.waves = propagator.waves();
+  stats.largest_wave = propagator.largest_wave();
+  stats.points_before_filter = propagator.emitted();
+  stats.patches = static_cast<long>(patches.size());
+  for (const AcceptedPatch& p : patches) ++stats.accepted_by_size[p.size];
+
+  PointCloud& cloud = result.cloud;
+  cloud.has_normals = cloud.has_colors = cloud.has_scores = cloud.has_views = true;
+  cloud.crs = block.crs;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!keep[i]) continue;
+    const DensePoint& d = points[i];
+    const AcceptedPatch& p = patches[d.patch];
+    const MatchImage& ref = group.images[p.ref];
+    CloudPoint c;
+    c.position = d.x + group.origin;
+    c.normal = p.normal.cast<float>();
+    const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, ref.color.cols - 1);
+    const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, ref.color.rows - 1);
+    const cv::Vec3b bgr = ref.color.at<cv::Vec3b>(y, x);
+    c.color = {bgr[2], bgr[1], bgr[0]};
+    c.score = p.score;
+    c.num_views = 1 + static_cast<int>(p.views.size());
+    cloud.points.push_back(c);
+  }
+  stats.points = static_cast<long>(cloud.points.size());
+  stats.kernels = engine.kernel_times();
+  end_stage("output");
+  if (own) own->Finish();
+  return result;
+}
+
+}  // namespace sapmvs

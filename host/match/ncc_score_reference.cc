@@ -1,0 +1,142 @@
+#include "match/ncc_score_reference.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+namespace {
+
+// Twin of NCC_MIN_AXIS_LENGTH in kernels/ncc_score.cl: a kernel-internal
+// geometric guard, not a tunable, so it is not passed as -D.
+constexpr double kNccMinAxisLength = 1e-3;
+constexpr size_t kMaxSamples = static_cast<size_t>(kMaxPatchSize) * kMaxPatchSize;
+
+// Signed distance of (x, y) to the edge of [0, w - 1] x [0, h - 1]: positive
+// inside, negative outside.
+double BorderDistance(const ImageLayout& layout, double x, double y) {
+  return std::min({x, y, (layout.width - 1) - x, (layout.height - 1) - y});
+}
+
+}  // namespace
+
+double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, int view,
+                                  int patch_size, double sigma_color, double* border_margin) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const int half = patch_size / 2;
+  const size_t num_samples = static_cast<size_t>(patch_size) * patch_size;
+  // The kernel's sigma is a float literal.
+  const double sigma = static_cast<float>(sigma_color);
+  // On the stack: the CPU backend scores millions of pairs.
+  std::array<double, kMaxSamples> a, b, weight;
+  weight.fill(1.0);
+
+  const int views[2] = {patch.reference, view};
+  const NccCamera& ref = group.cameras[patch.reference];
+  const Eigen::Vector3d c = Xyz(patch.center);
+  const Eigen::Vector3d n = Xyz(patch.normal);
+  const double depth = Xyzw(ref.p[2]).dot(c.homogeneous());
+  if (!(depth > 0.0)) return nan;
+  const double step = depth / ref.center.s[3];
+  // Same grid axes as the kernel (see ncc_score.cl).
+  const Eigen::Vector3d x_proj = Xyz(ref.x_axis) - Xyz(ref.x_axis).dot(n) * n;
+  if (!(x_proj.norm() >= kNccMinAxisLength)) return nan;
+  const Eigen::Vector3d x_dir = x_proj.normalized();
+  Eigen::Vector3d y_dir = n.cross(x_dir);
+  if (y_dir.dot(Xyz(ref.y_axis)) < 0.0) y_dir = -y_dir;
+
+  bool valid = true;
+  double margin = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < patch_size && valid; ++r) {
+    for (int col = 0; col < patch_size && valid; ++col) {
+      const Eigen::Vector3d x = c + ((col - half) * step) * x_dir + ((r - half) * step) * y_dir;
+      for (int v = 0; v < 2 && valid; ++v) {
+        const NccCamera& camera = group.cameras[views[v]];
+        const FloatImageView& image = group.images[views[v]];
+        const double w = Xyzw(camera.p[2]).dot(x.homogeneous());
+        if (!(w > 0.0)) {
+          valid = false;
+          break;
+        }
+        const double u = Xyzw(camera.p[0]).dot(x.homogeneous()) / w;
+        const double y = Xyzw(camera.p[1]).dot(x.homogeneous()) / w;
+        margin = std::min(margin, BorderDistance(image.layout, u, y));
+        const double value = BilinearSampleUnchecked(image, u, y);
+        if (std::isnan(value)) valid = false;
+        (v == 0 ? a : b)[static_cast<size_t>(r) * patch_size + col] = value;
+      }
+    }
+  }
+  if (border_margin != nullptr) *border_margin = margin;
+  if (!valid) return nan;
+
+  if (sigma > 0.0) {
+    // Same weights as ncc_weights: the spread of the 3 x 3 samples around
+    // the centre, times sigma.
+    const size_t mid = num_samples / 2;
+    double mean = 0.0, var = 0.0;
+    for (int r = -1; r <= 1; ++r)
+      for (int q = -1; q <= 1; ++q) mean += a[mid + r * patch_size + q];
+    mean /= 9.0;
+    for (int r = -1; r <= 1; ++r)
+      for (int q = -1; q <= 1; ++q) var += std::pow(a[mid + r * patch_size + q] - mean, 2);
+    const double s = sigma * std::sqrt(var / 9.0);
+    for (size_t k = 0; k < num_samples; ++k) {
+      const double d = a[k] - a[mid];
+      weight[k] = s > 0.0 ? std::exp(-0.5 * (d * d) / (s * s)) : 1.0;
+    }
+  }
+  double sum_w = 0.0;
+  double mean_a = 0.0;
+  double mean_b = 0.0;
+  for (size_t k = 0; k < num_samples; ++k) {
+    sum_w += weight[k];
+    mean_a += weight[k] * a[k];
+    mean_b += weight[k] * b[k];
+  }
+  mean_a /= sum_w;
+  mean_b /= sum_w;
+  double saa = 0.0;
+  double sbb = 0.0;
+  double sab = 0.0;
+  for (size_t k = 0; k < num_samples; ++k) {
+    saa += weight[k] * (a[k] - mean_a) * (a[k] - mean_a);
+    sbb += weight[k] * (b[k] - mean_b) * (b[k] - mean_b);
+    sab += weight[k] * (a[k] - mean_a) * (b[k] - mean_b);
+  }
+  const double min_sum = static_cast<double>(kNccMinVariance) * sum_w;
+  if (!(saa >= min_sum && sbb >= min_sum)) return nan;
+  return std::clamp(sab / std::sqrt(saa * sbb), -1.0, 1.0);
+}
+
+std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<NccPatch>& patches,
+                                      const std::vector<NccPair>& pairs, int patch_size,
+                                      std::vector<double>* border_margin, double sigma_color) {
+  NccScorerOptions options;
+  options.patch_size = patch_size;
+  options.sigma_color = sigma_color;
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("NccScoreReference: expected " + problem);
+  group.Validate();
+  ValidateNccBatch(patches, pairs, static_cast<int>(group.images.size()));
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> scores(pairs.size(), nan);
+  if (border_margin != nullptr) border_margin->assign(pairs.size(), nan);
+  const long n = static_cast<long>(pairs.size());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (long i = 0; i < n; ++i) {
+    scores[i] =
+        NccScoreReferenceUnchecked(group, patches[pairs[i].patch], pairs[i].view, patch_size,
+                                   sigma_color, border_margin ? &(*border_margin)[i] : nullptr);
+  }
+  return scores;
+}
+
+}  // namespace sapmvs

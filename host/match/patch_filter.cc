@@ -1,0 +1,334 @@
+#include "match/patch_filter.h"
+
+#include <flann/flann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <Eigen/Eigenvalues>
+
+namespace sapmvs {
+namespace {
+
+// Neighbours looked at per point in passes 2 and 3. With one point per
+// working pixel (sapmvs) 16 reach about 2.3 pixels; with one per 2x2 cell
+// (pmvs) about 4.5.
+constexpr int kNeighbours = 16;
+
+double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
+  return camera.Depth(x) / camera.intrinsics().MeanFocal();
+}
+
+int Find(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+}  // namespace
+
+std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOptions& options,
+                                   const std::vector<DensePoint>& points,
+                                   const std::vector<AcceptedPatch>& patches,
+                                   const std::vector<bool>& eligible) {
+  auto in = [&](size_t i) { return eligible.empty() || eligible[i]; };
+  const int n = static_cast<int>(group.images.size());
+  const int cs = options.cell_size;
+  struct Buffer {
+    int cols, rows;
+    std::vector<float> min_depth, front, back;
+  };
+  std::vector<Buffer> buffers(n);
+  for (int v = 0; v < n; ++v) {
+    Buffer& b = buffers[v];
+    b.cols = (group.images[v].camera.width() + cs - 1) / cs;
+    b.rows = (group.images[v].camera.height() + cs - 1) / cs;
+    const size_t size = static_cast<size_t>(b.cols) * b.rows;
+    b.min_depth.assign(size, std::numeric_limits<float>::infinity());
+    b.front.assign(size, 0);
+    b.back.assign(size, 0);
+  }
+  // Cell, depth and depth tolerance of point x in image v; false when x is
+  // behind the camera or off the image.
+  auto locate = [&](int v, const Eigen::Vector3d& x, size_t* cell, double* d, double* tol) {
+    const Camera& cam = group.images[v].camera;
+    *d = cam.Depth(x);
+    if (!(*d > 0)) return false;
+    const Eigen::Vector2d uv = cam.Project(x);
+    const int cx = static_cast<int>(std::floor((uv.x() + 0.5) / cs));
+    const int cy = static_cast<int>(std::floor((uv.y() + 0.5) / cs));
+    if (cx < 0 || cy < 0 || cx >= buffers[v].cols || cy >= buffers[v].rows) return false;
+    *cell = static_cast<size_t>(cy) * buffers[v].cols + cx;
+    *tol = options.depth_tolerance * *d / cam.intrinsics().MeanFocal();
+    return true;
+  };
+  // (image, cell, depth) of each point in each image it was matched in.
+  auto for_each_view = [&](size_t i, auto&& f) {
+    const AcceptedPatch& patch = patches[points[i].patch];
+    auto visit = [&](int v) {
+      size_t cell = 0;
+      double d = 0, tol = 0;
+      if (locate(v, points[i].x, &cell, &d, &tol)) f(v, cell, d, tol);
+    };
+    visit(patch.ref);
+    for (const int v : patch.views) visit(v);
+  };
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!in(i)) continue;
+    for_each_view(i, [&](int v, size_t cell, double d, double) {
+      float& m = buffers[v].min_depth[cell];
+      m = std::min(m, static_cast<float>(d));
+    });
+  }
+  auto weight = [&](size_t i) {
+    const AcceptedPatch& p = patches[points[i].patch];
+    return static_cast<float>((1 + p.views.size()) * std::max(0.0f, p.score));
+  };
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!in(i)) continue;
+    const float w = weight(i);
+    for_each_view(i, [&](int v, size_t cell, double d, double tol) {
+      Buffer& b = buffers[v];
+      (d <= b.min_depth[cell] + tol ? b.front[cell] : b.back[cell]) += w;
+    });
+  }
+  std::vector<bool> keep(points.size(), false);
+#pragma omp parallel for schedule(static)
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!in(i)) continue;
+    int visible = 0;
+    bool occluding = false;
+    std::vector<uint8_t> own(n, 0);
+    for_each_view(i, [&](int v, size_t cell, double d, double tol) {
+      own[v] = 1;
+      const Buffer& b = buffers[v];
+      if (d <= b.min_depth[cell] + tol) {
+        ++visible;
+        if (b.front[cell] < b.back[cell]) occluding = true;
+      }
+    });
+    // Free space: in an image the point was not matched in, a surface that
+    // image did match lying farther along the same line of sight was seen
+    // through the point, so the point floats in empty space (a window that
+    // fattened a roof over the ground beside it). It goes when those
+    // surfaces carry more support than it does.
+    float violated = 0;
+    if (!occluding) {
+      for (int v = 0; v < n; ++v) {
+        size_t cell = 0;
+        double d = 0, tol = 0;
+        if (own[v] || !locate(v, points[i].x, &cell, &d, &tol)) continue;
+        if (d < buffers[v].min_depth[cell] - tol) violated += buffers[v].front[cell];
+      }
+    }
+    keep[i] = visible >= options.min_image_num && !occluding && violated <= weight(i);
+  }
+  return keep;
+}
+
+std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
+                               const std::vector<DensePoint>& points,
+                               const std::vector<AcceptedPatch>& patches, MatchStats* stats,
+                               double score_floor) {
+  std::vector<bool> eligible(points.size());
+  long low = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    eligible[i] = patches[points[i].patch].score >= score_floor;
+    low += !eligible[i];
+  }
+  stats->removed_score = low;
+  std::vector<bool> keep = VisibilityFilter(group, options, points, patches, eligible);
+  std::vector<int> alive;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (keep[i]) alive.push_back(static_cast<int>(i));
+  }
+  stats->removed_visibility = static_cast<long>(points.size() - alive.size()) - low;
+  if (alive.empty()) return keep;
+
+  std::vector<float> xyz(alive.size() * 3);
+  for (size_t a = 0; a < alive.size(); ++a) {
+    for (int c = 0; c < 3; ++c) xyz[3 * a + c] = static_cast<float>(points[alive[a]].x[c]);
+  }
+  const int k = static_cast<int>(std::min<size_t>(kNeighbours + 1, alive.size()));
+  flann::Matrix<float> data(xyz.data(), alive.size(), 3);
+  flann::Index<flann::L2<float>> index(data, flann::KDTreeSingleIndexParams(10));
+  index.buildIndex();
+  std::vector<size_t> nn(alive.size() * k);
+  std::vector<float> nd(alive.size() * k);
+  flann::Matrix<size_t> nn_m(nn.data(), alive.size(), k);
+  flann::Matrix<float> nd_m(nd.data(), alive.size(), k);
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
+  params.cores = 0;
+  index.knnSearch(data, nn_m, nd_m, k, params);
+
+  // Distances, in footprints, from each patch's plane to the points of other
+  // patches among its points' neighbours (NaN for the other neighbours): the
+  // plane tolerance and test 2b below both come from them.
+  std::vector<float> radius(alive.size());
+  std::vector<float> foreign_distance(alive.size() * k, std::nanf(""));
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    const AcceptedPatch& patch = patches[p.patch];
+    const double fp = Footprint(group.images[patch.ref].camera, p.x);
+    radius[a] = static_cast<float>(options.neighbour_radius * fp);
+    for (int j = 0; j < k; ++j) {
+      const size_t b = nn[a * k + j];
+      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const DensePoint& q = points[alive[b]];
+      if (q.patch == p.patch) continue;
+      foreign_distance[a * k + j] =
+          static_cast<float>(std::abs(patch.normal.dot(q.x - patch.center)) / fp);
+    }
+  }
+  // The plane tolerance: at least plane_tolerance footprints, else
+  // plane_sigmas robust standard deviations of those distances (1.4826 x
+  // their median, as for half-normal residuals). Depth noise between patches
+  // differs with texture and geometry (median 0.18 footprints on the
+  // simulator's `small`, 0.43 on NGI's scans); one fixed tolerance either lets
+  // roof planes stray over the ground on the one or strips the other.
+  double tolerance = options.plane_tolerance;
+  {
+    std::vector<float> d;
+    for (const float v : foreign_distance) {
+      if (!std::isnan(v)) d.push_back(v);
+    }
+    if (!d.empty()) {
+      auto mid = d.begin() + d.size() / 2;
+      std::nth_element(d.begin(), mid, d.end());
+      tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * *mid);
+    }
+  }
+  stats->plane_tolerance = tolerance;
+
+  // 2. Neighbourhood and local plane.
+  std::vector<uint8_t> pass(alive.size(), 0);
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    const double fp = Footprint(group.images[patches[p.patch].ref].camera, p.x);
+    std::vector<Eigen::Vector3d> nbr;
+    for (int j = 0; j < k; ++j) {
+      const size_t b = nn[a * k + j];
+      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
+      nbr.push_back(points[alive[b]].x);
+    }
+    if (static_cast<int>(nbr.size()) < options.min_neighbours) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& q : nbr) mean += q;
+    mean /= static_cast<double>(nbr.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& q : nbr) cov += (q - mean) * (q - mean).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    const Eigen::Vector3d normal = es.eigenvectors().col(0);
+    pass[a] = std::abs(normal.dot(p.x - mean)) <= tolerance * fp;
+  }
+  // 2b. Patch support: the points of other patches next to a patch must lie
+  // on its plane. A sapmvs patch emits hundreds of points on one plane, which
+  // all pass test 2 among themselves however wrong the plane is; its
+  // neighbours are the independent evidence. A majority is asked for, not
+  // all, so a roof patch survives ground neighbours along its edge.
+  std::vector<int> foreign(patches.size(), 0), consistent(patches.size(), 0);
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const int id = points[alive[a]].patch;
+    for (int j = 0; j < k; ++j) {
+      const float d = foreign_distance[a * k + j];
+      if (std::isnan(d)) continue;
+      ++foreign[id];
+      if (d <= tolerance) ++consistent[id];
+    }
+  }
+  auto supported = [&](int id) {
+    return foreign[id] >= options.min_neighbours && 2 * consistent[id] >= foreign[id];
+  };
+  long removed_plane = 0;
+  for (size_t a = 0; a < alive.size(); ++a) {
+    if (pass[a] && !supported(points[alive[a]].patch)) pass[a] = 0;
+    if (!pass[a]) {
+      keep[alive[a]] = false;
+      ++removed_plane;
+    }
+  }
+  stats->removed_neighbourhood = removed_plane;
+
+  // 3. Small clusters among the survivors.
+  std::vector<int> parent(alive.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (size_t a = 0; a < alive.size(); ++a) {
+    if (!pass[a]) continue;
+    for (int j = 0; j < k; ++j) {
+      const size_t b = nn[a * k + j];
+      if (b == a || !pass[b] || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, static_cast<int>(b));
+      if (ra != rb) parent[ra] = rb;
+    }
+  }
+  std::vector<int> size(alive.size(), 0);
+  for (size_t a = 0; a < alive.size(); ++a) {
+    if (pass[a]) ++size[Find(parent, static_cast<int>(a))];
+  }
+  long removed_clusters = 0;
+  for (size_t a = 0; a < alive.size(); ++a) {
+    if (pass[a] && size[Find(parent, static_cast<int>(a))] < options.min_cluster_size) {
+      keep[alive[a]] = false;
+      ++removed_clusters;
+    }
+  }
+  stats->removed_clusters = removed_clusters;
+  return keep;
+}
+
+double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
+                  const std::vector<AcceptedPatch>& patches) {
+  double floor = options.threshold;
+  if (options.score_fence > 0 && points.size() >= 10) {
+    std::vector<double> s;
+    for (const DensePoint& d : points) s.push_back(patches[d.patch].score);
+    std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+    const double median = s[s.size() / 2];
+    for (double& v : s) v = std::abs(v - median);
+    std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
+    const double sigma = 1.4826 * s[s.size() / 2];
+    floor = std::max(options.threshold, median - options.score_fence * sigma);
+  }
+  return floor;
+}
+
+std::vector<std::pair<double, double>> SeedDepthFences(
+    const std::vector<std::vector<double>>& seed_depths, double gsd) {
+  std::vector<std::pair<double, double>> fences(seed_depths.size(), {0.0, 0.0});
+  for (size_t i = 0; i < seed_depths.size(); ++i) {
+    std::vector<double> d = seed_depths[i];
+    if (d.size() < 10) continue;
+    std::sort(d.begin(), d.end());
+    const double q1 = d[d.size() / 4], q3 = d[(3 * d.size()) / 4];
+    const double pad = 3.0 * (q3 - q1) + 10.0 * gsd;
+    fences[i] = {q1 - pad, q3 + pad};
+  }
+  return fences;
+}
+
+long ApplyDepthFences(const MatchGroupData& group, const std::vector<DensePoint>& points,
+                      const std::vector<AcceptedPatch>& patches,
+                      const std::vector<std::pair<double, double>>& fences,
+                      std::vector<bool>* keep) {
+  long removed = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!(*keep)[i]) continue;
+    const int ref = patches[points[i].patch].ref;
+    const auto [lo, hi] = fences[ref];
+    if (lo == 0 && hi == 0) continue;
+    const double depth = group.images[ref].camera.Depth(points[i].x);
+    if (depth < lo || depth > hi) {
+      (*keep)[i] = false;
+      ++removed;
+    }
+  }
+  return removed;
+}
+
+}  // namespace sapmvs

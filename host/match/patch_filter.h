@@ -1,0 +1,70 @@
+#pragma once
+// Filtering of the matched points (method.md 3.9). Points of patches that
+// score below the caller's score floor go first; then three passes:
+//  1. visibility: per image, a depth buffer on the cell grid from every
+//     point's reference and photo-consistent views. A point is occluded in an
+//     image where the front-most surface of its cell lies more than
+//     depth_tolerance footprints in front of it; it must be unoccluded in at
+//     least min_image_num images. A cell whose front-most points carry less
+//     support (num_views x score) than the points they hide counts those
+//     front points as occluding outliers, and they go (PMVS's filter 1).
+//     Free space: a point lying in front of a surface that an image it was
+//     not matched in did match there (so that image saw through it) goes when
+//     that surface carries more support than the point;
+//  2. neighbourhood: a point needs min_neighbours points within
+//     neighbour_radius footprints and must lie within the plane tolerance of
+//     the plane they fit, and a patch's plane must pass within it of most
+//     points of other patches around it. The tolerance is plane_sigmas robust
+//     standard deviations of those patch-to-patch distances, at least
+//     plane_tolerance footprints;
+//  3. clusters: points linked within neighbour_radius footprints form
+//     clusters; those smaller than min_cluster_size go.
+#include <utility>
+#include <vector>
+
+#include "match/group_data.h"
+#include "match/propagation.h"
+#include "sapmvs/match/match_stats.h"
+#include "sapmvs/match/matcher_options.h"
+
+namespace sapmvs {
+
+// keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
+// filled. Points of patches scoring below `score_floor` go first
+// (removed_score) and take no part in the other passes.
+std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
+                               const std::vector<DensePoint>& points,
+                               const std::vector<AcceptedPatch>& patches, MatchStats* stats,
+                               double score_floor = 0);
+
+// The score floor of `points` (their patches' scores): `options.threshold`,
+// raised to median - score_fence robust standard deviations (1.4826 MAD)
+// when score_fence > 0 and there are at least 10 points. Taken from the first
+// expansion's points, it keeps the weakest matches of a block out.
+double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
+                  const std::vector<AcceptedPatch>& patches);
+
+// Per image, the depths a point may lie at in it as its reference: Tukey's
+// fences on the image's seed depths (3 interquartile ranges beyond the
+// quartiles) plus 10 `gsd`; (0, 0) = no fence, when an image has fewer than
+// 10 seeds. A false match can grow into a cluster big enough to pass the
+// cluster filter (on the NGI block, clusters kilometres below the ground);
+// quartiles, not the seeds' extremes, because false seeds are among them.
+std::vector<std::pair<double, double>> SeedDepthFences(
+    const std::vector<std::vector<double>>& seed_depths, double gsd);
+
+// Clears keep[i] for kept points outside their reference image's fence;
+// returns how many.
+long ApplyDepthFences(const MatchGroupData& group, const std::vector<DensePoint>& points,
+                      const std::vector<AcceptedPatch>& patches,
+                      const std::vector<std::pair<double, double>>& fences,
+                      std::vector<bool>* keep);
+
+// The visibility pass alone (tests): keep[i] after pass 1, among the points
+// where `eligible` is true (all when empty).
+std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOptions& options,
+                                   const std::vector<DensePoint>& points,
+                                   const std::vector<AcceptedPatch>& patches,
+                                   const std::vector<bool>& eligible = {});
+
+}  // namespace sapmvs

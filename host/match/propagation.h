@@ -1,0 +1,105 @@
+#pragma once
+// The patch queue and the cell grids (method.md 3.8, 4.1). Accepted patches
+// emit points into empty cells of their reference image and mark the cells
+// their points fall in in every photo-consistent view; their neighbourhood
+// becomes the next wave's candidates:
+//   sapmvs: an L x L patch emits one point per reference pixel of its window
+//           (flood-filled from the centre, stopped by matched edges that are
+//           off the patch plane) and seeds new candidates just beyond its
+//           extent in 8 directions;
+//   pmvs:   a patch emits its centre and expands into the 4 neighbouring
+//           empty cells (PMVS's expansion in the patch plane).
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <opencv2/core.hpp>
+#include <unordered_map>
+#include <vector>
+
+#include "match/group_data.h"
+#include "match/patch_engine.h"
+#include "match/seed_matcher.h"
+
+namespace sapmvs {
+
+struct DensePoint {
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();   // local frame
+  int patch = -1;                                // index into Propagator::patches()
+  Eigen::Vector2f uv = Eigen::Vector2f::Zero();  // reference pixel
+};
+
+// Matched edge points of one image: where `matched` is set, `points` holds
+// the edge's 3D point (local frame) under the key y * cols + x. Sparse: a
+// dense 3-float image per image was 12 bytes a pixel for the few percent of
+// pixels that are matched edges.
+struct EdgeMap {
+  cv::Mat matched;  // CV_8U, 255 = matched edge pixel
+  std::unordered_map<int, Eigen::Vector3f> points;
+};
+
+class Propagator {
+ public:
+  Propagator(const MatchGroupData& group, const MatcherOptions& options, PatchEngine& engine);
+
+  // Tries each feature's candidates in order, one batch per rank, keeping
+  // the first accepted; accepted seeds start the front.
+  // `on_rank(rank, ranks, accepted)` after each rank of candidates is scored.
+  void RunSeeds(const std::vector<SeedFeature>& seeds,
+                const std::function<void(long, long, long)>& on_rank = {});
+  // Edge barriers for the flood fill (sapmvs mode); one map per image.
+  void SetEdges(std::vector<EdgeMap> edges) { edges_ = std::move(edges); }
+  // Waves until the front is empty (or max_waves). `on_wave` (may be empty)
+  // is called after each wave with its number, its size and the points.
+  void RunWaves(const std::function<void(long, long, long)>& on_wave);
+  // Drops the points where keep[i] is false and frees their cells in every
+  // grid, then queues the expansion of every patch that still has points
+  // (PMVS's expand-filter iterations: the ground a false patch held is open
+  // to its neighbours' planes again). The freed cells may be tried again.
+  void Prune(const std::vector<bool>& keep);
+
+  const std::vector<AcceptedPatch>& patches() const { return patches_; }
+  const std::vector<DensePoint>& points() const { return points_; }
+  long seeds_tried() const { return seeds_tried_; }
+  long seeds_accepted() const { return seeds_accepted_; }
+  long candidates() const { return candidates_; }
+  long waves() const { return waves_; }
+  long largest_wave() const { return largest_wave_; }
+  // Points emitted so far, including those Prune dropped.
+  long emitted() const { return emitted_; }
+  // Depths of the accepted seeds, per image (for the edge search range).
+  const std::vector<std::vector<double>>& seed_depths() const { return seed_depths_; }
+
+ private:
+  struct Grid {
+    int cols = 0, rows = 0;
+    std::vector<int> owner;                                // patch index, -1 = empty
+    std::vector<uint8_t> tries;                            // candidates started in the cell
+    int Index(const Eigen::Vector2d& uv, int cell) const;  // -1 outside
+  };
+  // Emits the points of `patch`; returns false (and stores nothing) when no
+  // cell was left for it.
+  bool Emit(const AcceptedPatch& patch);
+  void Expand(int patch_index, std::vector<PatchCandidate>* front);
+  bool IsBarrier(int image, int x, int y, const AcceptedPatch& patch) const;
+  // Accepts the evaluated candidates best score first; returns accepted indices.
+  std::vector<int> AcceptBatch(std::vector<std::optional<AcceptedPatch>>& results);
+
+  const MatchGroupData& group_;
+  const MatcherOptions& options_;
+  PatchEngine& engine_;
+  std::vector<Grid> grids_;
+  std::vector<EdgeMap> edges_;
+  std::vector<AcceptedPatch> patches_;
+  std::vector<DensePoint> points_;
+  std::vector<PatchCandidate> front_;
+  std::vector<std::vector<double>> seed_depths_;
+  long seeds_tried_ = 0, seeds_accepted_ = 0, candidates_ = 0, waves_ = 0, largest_wave_ = 0;
+  long emitted_ = 0;
+};
+
+// Intersection of the ray through pixel uv of `camera` with the plane
+// through `c` with normal `n`; NaN when parallel or behind the camera.
+Eigen::Vector3d IntersectPlane(const Camera& camera, const Eigen::Vector2d& uv,
+                               const Eigen::Vector3d& c, const Eigen::Vector3d& n);
+
+}  // namespace sapmvs

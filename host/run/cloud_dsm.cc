@@ -1,0 +1,162 @@
+#include "sapmvs/run/cloud_dsm.h"
+
+#include <flann/flann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <sstream>
+#include <unordered_map>
+
+#include "sapmvs/util/atomic_file.h"
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+
+std::string DsmOptions::Problem() const { return FirstRangeProblem(*this); }
+
+double MeanPointSpacing(const PointCloud& cloud, size_t max_samples) {
+  const size_t n = cloud.points.size();
+  if (n < 2) return 0;
+  // Relative to the first point: UTM coordinates leave no digits to spare.
+  const Eigen::Vector3d o = cloud.points.front().position;
+  std::vector<double> xyz(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d p = cloud.points[i].position - o;
+    xyz[3 * i] = p.x();
+    xyz[3 * i + 1] = p.y();
+    xyz[3 * i + 2] = p.z();
+  }
+  flann::Index<flann::L2<double>> index(flann::Matrix<double>(xyz.data(), n, 3),
+                                        flann::KDTreeSingleIndexParams(10));
+  index.buildIndex();
+  const size_t stride = std::max<size_t>(1, n / std::max<size_t>(1, max_samples));
+  std::vector<double> queries;
+  for (size_t i = 0; i < n; i += stride)
+    queries.insert(queries.end(), &xyz[3 * i], &xyz[3 * i + 3]);
+  const size_t m = queries.size() / 3;
+  std::vector<size_t> idx(2 * m);
+  std::vector<double> d2(2 * m);
+  flann::Matrix<size_t> idx_m(idx.data(), m, 2);
+  flann::Matrix<double> d2_m(d2.data(), m, 2);
+  index.knnSearch(flann::Matrix<double>(queries.data(), m, 3), idx_m, d2_m, 2,
+                  flann::SearchParams(flann::FLANN_CHECKS_UNLIMITED));
+  double sum = 0;
+  for (size_t q = 0; q < m; ++q) sum += std::sqrt(d2[2 * q + 1]);  // [0] is the point itself
+  return sum / static_cast<double>(m);
+}
+
+namespace {
+
+struct Extent {
+  double xmin = std::numeric_limits<double>::infinity(), ymin = xmin;
+  double xmax = -xmin, ymax = -xmin;
+};
+
+Extent CloudExtent(const PointCloud& cloud) {
+  Extent e;
+  for (const CloudPoint& p : cloud.points) {
+    e.xmin = std::min(e.xmin, p.position.x());
+    e.xmax = std::max(e.xmax, p.position.x());
+    e.ymin = std::min(e.ymin, p.position.y());
+    e.ymax = std::max(e.ymax, p.position.y());
+  }
+  return e;
+}
+
+}  // namespace
+
+CloudFootprint MeasureFootprint(const PointCloud& cloud, double cell_size) {
+  if (!(std::isfinite(cell_size) && cell_size > 0)) {
+    throw Error("footprint: expected a cell size > 0 (cell_size = " + std::to_string(cell_size) +
+                ")");
+  }
+  CloudFootprint f;
+  f.cell_size = cell_size;
+  if (cloud.points.empty()) return f;
+  const Eigen::Vector3d o = cloud.points.front().position;
+  std::unordered_map<long long, char> cells;
+  for (const CloudPoint& p : cloud.points) {
+    const long long cx = static_cast<long long>(std::floor((p.position.x() - o.x()) / cell_size));
+    const long long cy = static_cast<long long>(std::floor((p.position.y() - o.y()) / cell_size));
+    cells[(cx << 32) ^ (cy & 0xffffffffLL)] = 1;
+  }
+  f.occupied_cells = static_cast<long>(cells.size());
+  f.area = static_cast<double>(f.occupied_cells) * cell_size * cell_size;
+  f.density = static_cast<double>(cloud.points.size()) / f.area;
+  return f;
+}
+
+GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options, double* cell_size_used) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("dsm: expected " + problem);
+  if (cloud.points.empty()) throw Error("dsm: the cloud has no points");
+  double cell = options.cell_size;
+  if (cell == 0) cell = 2 * MeanPointSpacing(cloud);
+  if (!(cell > 0)) throw Error("dsm: the points coincide; give a cell size (--dsm-cell)");
+  const Extent e = CloudExtent(cloud);
+  GeoRaster r;
+  // Whole cells from a multiple of the cell size, so that rasters of
+  // neighbouring runs line up.
+  r.origin_x = std::floor(e.xmin / cell) * cell;
+  r.origin_y = std::ceil(e.ymax / cell) * cell;
+  if (r.origin_y == e.ymax) r.origin_y += cell;
+  const double w = std::floor((e.xmax - r.origin_x) / cell) + 1;
+  const double h = std::floor((r.origin_y - e.ymin) / cell) + 1;
+  if (w * h > static_cast<double>(1 << 28)) {
+    std::ostringstream s;
+    s << "dsm: a cell of " << cell << " gives " << w << " x " << h
+      << " cells; expected at most 2^28 (give a larger --dsm-cell)";
+    throw Error(s.str());
+  }
+  r.width = static_cast<int>(w);
+  r.height = static_cast<int>(h);
+  r.cell_size = cell;
+  r.crs = cloud.crs;
+  r.values.assign(static_cast<size_t>(r.width) * r.height, std::numeric_limits<float>::quiet_NaN());
+  std::vector<std::vector<float>> heights(r.values.size());
+  for (const CloudPoint& p : cloud.points) {
+    const int c =
+        std::clamp(static_cast<int>((p.position.x() - r.origin_x) / cell), 0, r.width - 1);
+    const int row =
+        std::clamp(static_cast<int>((r.origin_y - p.position.y()) / cell), 0, r.height - 1);
+    heights[static_cast<size_t>(row) * r.width + c].push_back(static_cast<float>(p.position.z()));
+  }
+  for (size_t i = 0; i < heights.size(); ++i) {
+    auto& v = heights[i];
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    r.values[i] = v[v.size() / 2];
+  }
+  for (int pass = 0; pass < options.fill_passes; ++pass) {
+    std::vector<float> next = r.values;
+    for (int row = 0; row < r.height; ++row) {
+      for (int c = 0; c < r.width; ++c) {
+        if (!std::isnan(r.at(c, row))) continue;
+        double sum = 0;
+        int n = 0;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int cc = c + dx, rr = row + dy;
+            if ((dx == 0 && dy == 0) || cc < 0 || rr < 0 || cc >= r.width || rr >= r.height) {
+              continue;
+            }
+            const float v = r.at(cc, rr);
+            if (!std::isnan(v)) {
+              sum += v;
+              ++n;
+            }
+          }
+        }
+        if (n >= 5) next[static_cast<size_t>(row) * r.width + c] = static_cast<float>(sum / n);
+      }
+    }
+    r.values.swap(next);
+  }
+  if (cell_size_used) *cell_size_used = cell;
+  return r;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,220 @@
+#include "sapmvs/run/cloud_merge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <sstream>
+#include <unordered_map>
+
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+
+std::string MergeOptions::Problem() const {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    std::ostringstream s;
+    s << "a merge radius finite and > 0 (radius = " << radius << ")";
+    return s.str();
+  }
+  return "";
+}
+
+int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
+  int best = -1;
+  double best_d2 = 0;
+  for (size_t g = 0; g < centers.size(); ++g) {
+    const double d2 = (Eigen::Vector2d(x, y) - centers[g]).squaredNorm();
+    if (best < 0 || d2 < best_d2) {
+      best = static_cast<int>(g);
+      best_d2 = d2;
+    }
+  }
+  return best;
+}
+
+namespace {
+
+struct CellKey {
+  int64_t x, y, z;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct CellHash {
+  size_t operator()(const CellKey& k) const {
+    // Unsigned: the products wrap, where signed ones overflowed (undefined)
+    // for cells of UTM-sized coordinates (UBSan, CloudMerge tests).
+    return static_cast<size_t>(static_cast<uint64_t>(k.x) * 73856093ULL ^
+                               static_cast<uint64_t>(k.y) * 19349663ULL ^
+                               static_cast<uint64_t>(k.z) * 83492791ULL);
+  }
+};
+
+// Points hashed into cubes of side `radius`, so that everything within the
+// radius of a point lies in its cube or the 26 around it.
+template <typename Ref>
+class RadiusGrid {
+ public:
+  explicit RadiusGrid(double radius) : r_(radius) {}
+  void Insert(const Eigen::Vector3d& p, const Ref& ref) { cells_[Key(p)].push_back(ref); }
+  // True as soon as `hit(ref)` holds for an inserted ref in a neighbouring cube.
+  template <typename Hit>
+  bool AnyNear(const Eigen::Vector3d& p, const Hit& hit) const {
+    const CellKey k = Key(p);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(CellKey{k.x + dx, k.y + dy, k.z + dz});
+          if (it == cells_.end()) continue;
+          for (const Ref& ref : it->second) {
+            if (hit(ref)) return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+  // Calls `visit(ref)` for every inserted ref in a neighbouring cube.
+  template <typename Visit>
+  void ForEachNear(const Eigen::Vector3d& p, const Visit& visit) const {
+    AnyNear(p, [&](const Ref& ref) {
+      visit(ref);
+      return false;
+    });
+  }
+
+ private:
+  CellKey Key(const Eigen::Vector3d& p) const {
+    return CellKey{static_cast<int64_t>(std::floor(p.x() / r_)),
+                   static_cast<int64_t>(std::floor(p.y() / r_)),
+                   static_cast<int64_t>(std::floor(p.z() / r_))};
+  }
+  double r_;
+  std::unordered_map<CellKey, std::vector<Ref>, CellHash> cells_;
+};
+
+struct Ref {
+  int group;
+  size_t index;
+};
+
+}  // namespace
+
+PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOptions& options,
+                            MergeStats* stats) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("merge: expected " + problem);
+  MergeStats local;
+  MergeStats& st = stats ? *stats : local;
+  st = MergeStats{};
+  st.kept_by_group.assign(groups.size(), 0);
+  st.core_by_group.assign(groups.size(), 0);
+  PointCloud out;
+  if (groups.empty()) return out;
+  for (const GroupCloud& g : groups) {
+    if (!g.cloud) throw Error("merge: a group has no cloud");
+  }
+  const PointCloud& first = *groups.front().cloud;
+  out.crs = first.crs;
+  out.has_normals = first.has_normals;
+  out.has_colors = first.has_colors;
+  out.has_scores = first.has_scores;
+  out.has_views = first.has_views;
+
+  std::vector<Eigen::Vector2d> centers;
+  for (const GroupCloud& g : groups) centers.push_back(g.center);
+  struct Item {
+    Ref ref;
+    bool core;
+    float score;
+  };
+  std::vector<Item> items;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const auto& pts = groups[g].cloud->points;
+    st.input += static_cast<long>(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const bool core =
+          CoreOwner(centers, pts[i].position.x(), pts[i].position.y()) == static_cast<int>(g);
+      items.push_back({{static_cast<int>(g), i}, core, pts[i].score});
+    }
+  }
+  // Core points first so that the owner's surface wins; then the better match.
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    if (a.core != b.core) return a.core;
+    return a.score > b.score;
+  });
+
+  const double r2 = options.radius * options.radius;
+  auto point = [&](const Ref& ref) -> const CloudPoint& {
+    return groups[ref.group].cloud->points[ref.index];
+  };
+  RadiusGrid<Ref> kept(options.radius);
+  std::vector<Ref> order;
+  for (const Item& item : items) {
+    const Eigen::Vector3d& p = point(item.ref).position;
+    const bool duplicate = kept.AnyNear(p, [&](const Ref& other) {
+      return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
+    });
+    if (duplicate) {
+      ++st.duplicates;
+      continue;
+    }
+    kept.Insert(p, item.ref);
+    order.push_back(item.ref);
+    ++st.kept_by_group[item.ref.group];
+    if (item.core) ++st.core_by_group[item.ref.group];
+  }
+  // Output in group order, each group's points in their original order, so
+  // that the merged file does not depend on score ties.
+  std::sort(order.begin(), order.end(), [](const Ref& a, const Ref& b) {
+    return a.group != b.group ? a.group < b.group : a.index < b.index;
+  });
+  out.points.reserve(order.size());
+  for (const Ref& ref : order) out.points.push_back(point(ref));
+  st.kept = static_cast<long>(out.points.size());
+  return out;
+}
+
+long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of,
+                          double radius) {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    throw Error("cross-group pairs: expected a radius > 0");
+  }
+  if (group_of.size() != cloud.points.size()) {
+    throw Error("cross-group pairs: expected one group per point (" +
+                std::to_string(group_of.size()) + " for " + std::to_string(cloud.points.size()) +
+                " points)");
+  }
+  RadiusGrid<size_t> grid(radius);
+  for (size_t i = 0; i < cloud.points.size(); ++i) grid.Insert(cloud.points[i].position, i);
+  long pairs = 0;
+  for (size_t i = 0; i < cloud.points.size(); ++i) {
+    const Eigen::Vector3d& p = cloud.points[i].position;
+    grid.ForEachNear(p, [&](size_t j) {
+      pairs +=
+          j > i && group_of[j] != group_of[i] && (cloud.points[j].position - p).norm() <= radius;
+    });
+  }
+  return pairs;
+}
+
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
+                        std::vector<bool>* has) {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    throw Error("neighbour count: expected a radius > 0");
+  }
+  RadiusGrid<size_t> grid(radius);
+  for (size_t i = 0; i < to.points.size(); ++i) grid.Insert(to.points[i].position, i);
+  long with = 0;
+  if (has) has->assign(from.points.size(), false);
+  for (size_t i = 0; i < from.points.size(); ++i) {
+    const CloudPoint& p = from.points[i];
+    const bool near = grid.AnyNear(p.position, [&](size_t j) {
+      return (to.points[j].position - p.position).norm() <= radius;
+    });
+    with += near;
+    if (has) (*has)[i] = near;
+  }
+  return with;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,323 @@
+#include "sapmvs/run/dense_run.h"
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <sstream>
+
+#include "device/make_patch_kernels.h"
+#include "match/patch_kernels.h"
+#include "run/run_checkpoint.h"
+#include "run/run_report.h"
+#include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/match/match_group.h"
+#include "sapmvs/plan/grouping.h"
+#include "sapmvs/run/cloud_dsm.h"
+#include "sapmvs/run/cloud_las.h"
+#include "sapmvs/run/cloud_merge.h"
+#include "sapmvs/run/dsm_picture.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/log.h"
+#include "sapmvs/util/memory_use.h"
+#include "sapmvs/util/output_folder.h"
+#include "sapmvs/util/progress.h"
+#include "util/run_progress.h"
+
+namespace sapmvs {
+
+namespace {
+
+double Since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::string Seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f s", s);
+  return buf;
+}
+
+void AddStats(const MatchStats& s, MatchStats* sum) {
+  sum->images += s.images;
+  sum->features += s.features;
+  sum->seeds_tried += s.seeds_tried;
+  sum->seeds_accepted += s.seeds_accepted;
+  sum->edge_points += s.edge_points;
+  sum->matched_edge_points += s.matched_edge_points;
+  sum->candidates += s.candidates;
+  sum->patches += s.patches;
+  sum->waves += s.waves;
+  sum->largest_wave = std::max(sum->largest_wave, s.largest_wave);
+  for (const auto& [size, n] : s.accepted_by_size) sum->accepted_by_size[size] += n;
+  sum->points_before_filter += s.points_before_filter;
+  // A run's floor and tolerance: the highest of its groups' (each group has
+  // its own).
+  sum->score_floor = std::max(sum->score_floor, s.score_floor);
+  sum->removed_score += s.removed_score;
+  sum->plane_tolerance = std::max(sum->plane_tolerance, s.plane_tolerance);
+  sum->removed_visibility += s.removed_visibility;
+  sum->removed_neighbourhood += s.removed_neighbourhood;
+  sum->removed_clusters += s.removed_clusters;
+  sum->removed_depth_range += s.removed_depth_range;
+  sum->points += s.points;
+  for (const auto& [name, t] : s.stages) {
+    auto it = std::find_if(sum->stages.begin(), sum->stages.end(),
+                           [&](const auto& e) { return e.first == name; });
+    if (it == sum->stages.end()) {
+      sum->stages.emplace_back(name, t);
+    } else {
+      it->second.wall += t.wall;
+      it->second.device += t.device;
+    }
+  }
+  for (const auto& [name, k] : s.kernels) {
+    KernelTime& d = sum->kernels[name];
+    d.launches += k.launches;
+    d.items += k.items;
+    d.ncc_evaluations += k.ncc_evaluations;
+    d.patch_size = k.patch_size;
+    d.seconds += k.seconds;
+    d.max_seconds = std::max(d.max_seconds, k.max_seconds);
+  }
+  sum->gsd = s.gsd;
+}
+
+}  // namespace
+
+RunReport RunDense(const RunOptions& options) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("run: expected " + problem);
+  // Everything that can be refused is checked before the first file is
+  // written, so a failed start leaves nothing that stops the corrected
+  // command: the folder, the block and its CRS, the device.
+  OutputFolder::Check(options.out, "run");
+  const auto start = std::chrono::steady_clock::now();
+  RunReport report;
+  report.out = options.out;
+  report.start_time = std::chrono::system_clock::now();
+  auto stage_start = start;
+  auto end_stage = [&](const std::string& name) {
+    report.stages.emplace_back(name, Since(stage_start));
+    LogDetail("run: " + name + " " + Seconds(report.stages.back().second));
+    stage_start = std::chrono::steady_clock::now();
+  };
+
+  const Block block = ReadBlock(options.block, options.read);
+  try {
+    CrsToWkt(block.crs);  // what cloud.las and dsm.tif will need, after all the matching
+  } catch (const Error& e) {
+    throw Error(block.source.string() + ": " + e.what());
+  }
+  report.images = static_cast<int>(block.images.size());
+  const BlockGeometry geometry = EstimateBlockGeometry(block);
+  // Without a GSD the merge radius would be 0, found only after matching.
+  if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
+    throw Error(reason);
+  }
+  const GroupingPlan plan = PlanGroups(block, options.grouping, options.matcher, &geometry);
+  report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
+  for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
+  end_stage("plan");
+
+  PatchKernelsOptions kernel_options;
+  kernel_options.device = options.device;
+  kernel_options.profile = options.profile;
+  const std::unique_ptr<PatchKernels> kernels = MakePatchKernels(kernel_options);
+  const KernelDevice& device = kernels->device();
+  report.device = device.description;
+  report.device_info = {device.name, device.vendor, device.platform, device.type};
+  LogDetail("device: " + report.device);
+
+  const OutputFolder folder(options.out, "run", {"groups"});
+  if (options.restart) RemoveRunOutputs(options.out);
+  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher, options.restart);
+
+  const bool show = options.matcher.progress && Progress::TerminalAllowsProgress();
+  const int n = static_cast<int>(plan.groups.size());
+  // The groups this call will match, for the ETA: not checkpointed, and at
+  // most max_groups of them.
+  int to_match = 0;
+  long images_to_match = 0;
+  for (int g = 0; g < n; ++g) {
+    if (checkpoints.Done(g) || (options.max_groups > 0 && to_match >= options.max_groups)) continue;
+    ++to_match;
+    images_to_match += static_cast<long>(plan.groups[g].images.size());
+  }
+  RunProgress progress(to_match, images_to_match, show);
+  int matched_now = 0;
+  bool stopped = false;  // groups left for a later call (max_groups)
+  for (int g = 0; g < n; ++g) {
+    GroupRun run;
+    run.index = g;
+    for (const int i : plan.groups[g].images) run.images.push_back(block.images[i].name);
+    if (checkpoints.Done(g)) {
+      const GroupCheckpoint c = checkpoints.Read(g);
+      run.points = c.points;
+      run.seconds = c.seconds;
+      run.resumed = true;
+      report.groups.push_back(run);
+      continue;
+    }
+    if (options.max_groups > 0 && matched_now >= options.max_groups) {
+      stopped = true;
+      report.groups.push_back(run);
+      continue;
+    }
+    progress.StartGroup(g, n, static_cast<long>(plan.groups[g].images.size()));
+    const auto t0 = std::chrono::steady_clock::now();
+    MatchResult result =
+        MatchGroup(block, plan.groups[g].images, options.matcher, *kernels, &geometry,
+                   [&](const MatchProgressEvent& e) { progress.Update(e); });
+    run.seconds = Since(t0);
+    run.points = static_cast<long>(result.cloud.points.size());
+    progress.EndGroup(run.points);
+    AddStats(result.stats, &report.stats);
+    for (const auto& [name, t] : result.stats.stages) {
+      LogDetail("group " + std::to_string(g + 1) + "/" + std::to_string(n) + ": " + name + " " +
+                Seconds(t.wall) +
+                (options.profile ? ", " + Seconds(t.device) + " in kernels" : ""));
+    }
+    checkpoints.Write(g, result.cloud, run.seconds, result.stats, options.profile);
+    ++matched_now;
+    report.groups.push_back(run);
+  }
+  progress.Finish();
+  end_stage("match");
+  if (stopped) {
+    report.total_seconds = Since(start);
+    report.peak_rss_bytes = PeakRssBytes();
+    return report;  // resumable
+  }
+
+  // Merge from the checkpoints, fresh or resumed alike.
+  std::vector<PointCloud> clouds(n);
+  std::vector<GroupCloud> parts(n);
+  for (int g = 0; g < n; ++g) {
+    clouds[g] = ReadPly(checkpoints.CloudPath(g));
+    parts[g].cloud = &clouds[g];
+    parts[g].center = plan.groups[g].center + block.origin.head<2>();
+  }
+  MergeOptions mo;
+  mo.radius =
+      options.merge_radius_gsd * geometry.gsd_median * std::ldexp(1.0, options.matcher.level);
+  PointCloud merged = MergeGroupClouds(parts, mo, &report.merge);
+  if (merged.crs.empty()) merged.crs = block.crs;
+  clouds.clear();
+  end_stage("merge");
+  if (merged.points.empty()) {
+    throw Error(options.block.string() +
+                ": no point survived matching and filtering; nothing "
+                "written (check the orientation, or lower --threshold)");
+  }
+  report.points = static_cast<long>(merged.points.size());
+  report.bounds_min = report.bounds_max = merged.points.front().position;
+  for (const CloudPoint& p : merged.points) {
+    report.bounds_min = report.bounds_min.cwiseMin(p.position);
+    report.bounds_max = report.bounds_max.cwiseMax(p.position);
+  }
+  report.mean_spacing = MeanPointSpacing(merged);
+  const GeoRaster dsm = RasterizeDsm(merged, options.dsm, &report.dsm_cell);
+  const CloudFootprint fp = MeasureFootprint(merged, report.dsm_cell);
+  report.area = fp.area;
+  report.density = fp.density;
+  end_stage("statistics");
+
+  WritePly(options.out / "cloud.ply", merged);
+  LasWriteOptions lo;
+  lo.version = options.las_version;
+  lo.crs = block.crs;
+  WriteCloudLas(options.out / "cloud.las", merged, lo);
+  WriteGeoTiff(options.out / "dsm.tif", dsm);
+  WriteDsmPictures(dsm, options.out / "dsm_color.tif", options.out / "dsm.png");
+  end_stage("write");
+  report.finished = true;
+  report.total_seconds = Since(start);
+  report.peak_rss_bytes = PeakRssBytes();
+  report.end_time = std::chrono::system_clock::now();
+  WriteRunReport(options, report, block, plan);
+  return report;
+}
+
+void PrintRunSummary(const RunReport& report, std::ostream& out) {
+  const MatchStats& s = report.stats;
+  out << "device        " << report.device << "\n";
+  out << "groups        " << report.groups.size() << " (" << report.strategy << ")\n";
+  if (!report.ungrouped.empty()) {
+    out << "ungrouped     " << report.ungrouped.size() << " images in no group (not matched):";
+    for (const std::string& name : report.ungrouped) out << " " << name;
+    out << "\n";
+  }
+  for (const GroupRun& g : report.groups) {
+    out << "  group " << std::setw(3) << g.index + 1 << "  " << std::setw(2) << g.images.size()
+        << " images  ";
+    if (g.resumed) {
+      out << std::setw(9) << g.points << " points  (checkpoint)";
+    } else if (g.seconds > 0 || g.points > 0) {
+      out << std::setw(9) << g.points << " points  " << FormatHms(g.seconds);
+    } else {
+      out << "          not run yet";
+    }
+    out << "\n";
+  }
+  if (s.waves > 0) {
+    out << "propagation   " << s.waves << " waves, " << s.candidates << " candidates, " << s.patches
+        << " patches";
+    if (!s.accepted_by_size.empty()) {
+      out << " (";
+      bool first = true;
+      for (auto it = s.accepted_by_size.rbegin(); it != s.accepted_by_size.rend(); ++it) {
+        out << (first ? "" : ", ") << it->first << "x" << it->first << ": " << it->second;
+        first = false;
+      }
+      out << ")";
+    }
+    out << "\n";
+  }
+  out << std::fixed << std::setprecision(2);
+  for (const auto& [name, t] : s.stages) {
+    out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t.wall
+        << " s wall";
+    if (t.device > 0) out << ", " << t.device << " s in kernels";
+    if (t.peak_rss_bytes > 0)
+      out << ", peak " << std::lround(t.peak_rss_bytes / (1 << 20)) << " MiB";
+    out << "\n";
+  }
+  for (const auto& [name, t] : report.stages) {
+    if (name == "match") continue;
+    out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t
+        << " s wall\n";
+  }
+  if (!report.finished) {
+    out << "stopped       after the groups asked for; run again to resume\n";
+    out.unsetf(std::ios::floatfield);
+    return;
+  }
+  out << "merge         " << report.merge.input << " -> " << report.points << " points ("
+      << report.merge.duplicates << " cross-group duplicates dropped)\n";
+  out << "\n";
+  out << "images  points      run time  avg. distance  density (pts/unit^2)\n";
+  out << std::left << std::setw(8) << report.images << std::setw(12) << report.points
+      << std::setw(10) << FormatHms(report.total_seconds) << std::right << std::setprecision(3)
+      << std::setw(15) << report.mean_spacing << std::setw(22) << report.density << "\n\n";
+  out << std::setprecision(2);
+  out << "total         " << report.total_seconds << " s, peak memory "
+      << report.peak_rss_bytes / (1 << 20) << " MiB\n";
+  for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm_color.tif", "dsm.png", "dsm.pgw",
+                        "report.json"}) {
+    out << "wrote         " << (report.out / f).string() << "\n";
+  }
+  out.unsetf(std::ios::floatfield);
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,164 @@
+#include "run/run_report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+
+#include "sapmvs/io/raster_io.h"
+#include "sapmvs/util/atomic_file.h"
+#include "sapmvs/util/error.h"
+#include "sapmvs/util/log.h"
+#include "sapmvs/util/thread_count.h"
+#include "util/build_info.h"
+#include "util/machine_info.h"
+#include "util/option_json.h"
+
+namespace sapmvs {
+
+std::string FormatHms(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  return buf;
+}
+
+void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
+  WriteStreamAtomically(path, [&](std::ostream& f) { f << std::setw(2) << j << "\n"; });
+}
+
+nlohmann::json MatcherOptionsJson(const MatcherOptions& m) { return OptionsJson(m); }
+
+nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
+  nlohmann::json j;
+  j["images"] = s.images;
+  j["features"] = s.features;
+  j["seeds"] = {{"tried", s.seeds_tried}, {"accepted", s.seeds_accepted}};
+  j["edges"] = {{"edge_pixels", s.edge_points}, {"matched", s.matched_edge_points}};
+  j["propagation"] = {{"waves", s.waves},
+                      {"candidates", s.candidates},
+                      {"largest_wave", s.largest_wave},
+                      {"patches", s.patches}};
+  nlohmann::json sizes = nlohmann::json::object();
+  for (const auto& [size, count] : s.accepted_by_size) sizes[std::to_string(size)] = count;
+  j["propagation"]["accepted_by_size"] = sizes;
+  j["filter"] = {{"points_before", s.points_before_filter},
+                 {"score_floor", s.score_floor},
+                 {"plane_tolerance", s.plane_tolerance},
+                 {"removed_score", s.removed_score},
+                 {"removed_visibility", s.removed_visibility},
+                 {"removed_neighbourhood", s.removed_neighbourhood},
+                 {"removed_clusters", s.removed_clusters},
+                 {"removed_depth_range", s.removed_depth_range},
+                 {"points", s.points}};
+  nlohmann::json stages = nlohmann::json::array();
+  for (const auto& [name, t] : s.stages) {
+    nlohmann::json stage = {{"stage", name}, {"wall_seconds", t.wall}};
+    if (device_times) stage["device_seconds"] = t.device;
+    stages.push_back(stage);
+  }
+  j["stages"] = stages;
+  nlohmann::json kernels = nlohmann::json::array();
+  for (const auto& [name, t] : s.kernels) {
+    nlohmann::json kernel = {{"kernel", name}, {"launches", t.launches}, {"items", t.items}};
+    if (device_times) kernel["device_seconds"] = t.seconds;
+    kernels.push_back(kernel);
+  }
+  j["kernels"] = kernels;
+  j["gsd_at_level"] = s.gsd;
+  return j;
+}
+
+namespace {
+
+nlohmann::json CrsJson(const std::string& crs) {
+  if (crs.empty()) return nullptr;
+  const CrsIdentity id = IdentifyCrs(crs);
+  return {{"epsg", id.epsg > 0 ? nlohmann::json(id.epsg) : nlohmann::json(nullptr)},
+          {"name", id.name},
+          {"definition", crs}};
+}
+
+nlohmann::json MachineJson() {
+  const MachineInfo m = DescribeMachine();
+  return {{"hostname", m.hostname},
+          {"cpu", m.cpu_model},
+          {"cores", m.cores},
+          {"memory_bytes", m.memory_bytes},
+          {"threads", HostThreadCount()}};
+}
+
+nlohmann::json Xyz(const Eigen::Vector3d& v) { return {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
+
+}  // namespace
+
+void WriteRunReport(const RunOptions& options, const RunReport& report, const Block& block,
+                    const GroupingPlan& plan) {
+  nlohmann::json j;
+  j["report_version"] = kRunReportVersion;
+  j["sapmvs"] = {{"version", BuildVersion()}, {"commit", BuildCommit()}};
+  j["command_line"] = options.command_line;
+  j["start_time"] = Iso8601Utc(report.start_time);
+  j["end_time"] = Iso8601Utc(report.end_time);
+  j["machine"] = MachineJson();
+  j["block"] = options.block.string();
+  j["mode"] = ToString(options.matcher.mode);
+  j["level"] = options.matcher.level;
+  j["device"] = {{"description", report.device},
+                 {"name", report.device_info.name},
+                 {"vendor", report.device_info.vendor},
+                 {"platform", report.device_info.platform},
+                 {"type", report.device_info.type}};
+  j["crs"] = CrsJson(block.crs);
+  j["bounds"] = {{"min", Xyz(report.bounds_min)}, {"max", Xyz(report.bounds_max)}};
+  j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
+  j["images"] = report.images;
+  j["points"] = report.points;
+  j["total_seconds"] = report.total_seconds;
+  j["total_hms"] = FormatHms(report.total_seconds);
+  j["mean_point_spacing"] = report.mean_spacing;
+  j["density_per_unit2"] = report.density;
+  j["covered_area_unit2"] = report.area;
+  j["dsm_cell"] = report.dsm_cell;
+  j["peak_rss_bytes"] = report.peak_rss_bytes;
+  j["grouping"] = report.strategy;
+  j["ungrouped"] = report.ungrouped;
+  j["matcher"] = MatcherOptionsJson(options.matcher);
+  nlohmann::json groups = nlohmann::json::array();
+  for (size_t g = 0; g < report.groups.size(); ++g) {
+    const GroupRun& r = report.groups[g];
+    nlohmann::json e = {{"group", r.index + 1},        {"images", r.images},
+                        {"points", r.points},          {"seconds", r.seconds},
+                        {"hms", FormatHms(r.seconds)}, {"from_checkpoint", r.resumed}};
+    if (g < plan.groups.size()) {
+      const Eigen::Vector2d c = plan.groups[g].center + block.origin.head<2>();
+      e["center"] = {c.x(), c.y()};
+      e["memory_estimate_bytes"] = {{"device", plan.groups[g].memory.device_bytes},
+                                    {"host", plan.groups[g].memory.host_bytes}};
+    }
+    if (g < report.merge.kept_by_group.size()) {
+      e["kept_after_merge"] = report.merge.kept_by_group[g];
+      e["kept_in_core"] = report.merge.core_by_group[g];
+    }
+    groups.push_back(e);
+  }
+  j["groups"] = groups;
+  j["merge"] = {{"input", report.merge.input},
+                {"kept", report.merge.kept},
+                {"cross_group_duplicates", report.merge.duplicates}};
+  // Matching stages (summed over the groups matched in this call, with their
+  // device time), then the run's own: plan, match (all groups), merge, ...
+  nlohmann::json matching = MatchStatsJson(report.stats, options.profile);
+  nlohmann::json stages = matching["stages"];
+  for (const auto& [name, t] : report.stages) {
+    stages.push_back({{"stage", "run " + name}, {"wall_seconds", t}, {"hms", FormatHms(t)}});
+  }
+  j["stages"] = stages;
+  j["kernels"] = matching["kernels"];
+  matching.erase("stages");
+  matching.erase("kernels");
+  j["matching"] = matching;
+  WriteJsonFile(options.out / "report.json", j);
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,55 @@
+#pragma once
+// Dense matching of one group of images (method.md 3 and 4): seeds from
+// Harris / DoG features matched along epipolar lines, propagation in waves
+// refined and scored by the patch kernels (an OpenCL device or the CPU
+// reference, host/match/patch_kernels.h), then filtering. Two modes share
+// the engine: `sapmvs` (the paper's self-adaptive patch) and `pmvs`
+// (Furukawa's one-patch-per-cell expansion).
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sapmvs/block/block.h"
+#include "sapmvs/io/ply_io.h"
+#include "sapmvs/match/match_stats.h"
+#include "sapmvs/match/matcher_options.h"
+#include "sapmvs/util/match_progress.h"
+
+namespace sapmvs {
+
+struct BlockGeometry;
+
+class PatchKernels;
+
+struct MatchResult {
+  PointCloud cloud;  // world coordinates (the local origin added back)
+  MatchStats stats;
+};
+
+// Matches images `image_ids` of `block` (all when empty) with `kernels`
+// (MakePatchKernels). `geometry`:
+// EstimateBlockGeometry(block) when the caller already has it, else nullptr.
+// `on_progress` hears each stage and wave; without it, options.progress
+// draws a status line of its own on a terminal. Throws Error for bad
+// options, unreadable images or fewer than 2 usable images.
+MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
+                       const MatcherOptions& options, PatchKernels& kernels,
+                       const BlockGeometry* geometry = nullptr,
+                       const MatchProgressFn& on_progress = {});
+
+// What matching one group holds, per unit, for the planner's memory model
+// (grouping.h EstimateGroupMemory, which spells out each term): per pixel of
+// the group's images on the device and on the host, per image cell, and per
+// candidate of a wave on both sides, with kMaxViews - 1 views to a patch.
+struct MatcherMemoryModel {
+  double device_bytes_per_pixel = 0;
+  double host_bytes_per_pixel = 0;
+  double host_bytes_per_cell = 0;
+  double device_bytes_per_candidate = 0;
+  double host_bytes_per_candidate = 0;
+};
+MatcherMemoryModel MatcherMemory();
+
+}  // namespace sapmvs

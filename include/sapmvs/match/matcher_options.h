@@ -1,0 +1,287 @@
+#pragma once
+// The matcher's options (MatcherOptions) and their description, apart from
+// the matcher (match_group.h) so that the planner, the checkpoints and the CLI
+// can take them without the matcher's API.
+#include <string>
+#include <vector>
+
+#include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/option_spec.h"
+
+namespace sapmvs {
+
+enum class MatchMode { kSapmvs, kPmvs };
+std::string ToString(MatchMode mode);
+// Throws Error naming `text` unless it is "sapmvs" or "pmvs".
+MatchMode ParseMatchMode(const std::string& text);
+inline void ParseOptionValue(const std::string& text, MatchMode* mode) {
+  *mode = ParseMatchMode(text);
+}
+
+struct MatcherOptions {
+  MatchMode mode = MatchMode::kSapmvs;
+  // Pyramid level the group is matched at: 0 = full resolution, 1 = half
+  // (PMVS2's `level`), ... Each level halves both image sides.
+  int level = 1;
+  // Side of an image cell in pixels at `level` (PMVS2's `csize`): the grid
+  // that says which parts of an image are already covered.
+  int cell_size = 2;
+  // Mean NCC over the accepted views a patch needs after optimisation
+  // (PMVS2's `threshold`), and the per-view NCC a view needs to count.
+  double threshold = 0.7;
+  // Per-view NCC a view needs before optimisation to take part in it.
+  double threshold_before = 0.4;
+  // Images (reference included) a patch must be photo-consistent in
+  // (PMVS2's `minImageNum`), 2 to kMaxViews.
+  int min_image_num = 3;
+  // PMVS2's `maxAngle`, degrees: a patch is accepted only if some pair of
+  // the images it is matched in (the reference included) meets at it at more
+  // than this (and less than view_angle_deg), so that its depth is
+  // constrained. Each view on its own may be narrower: at the paper's 88 %
+  // forward overlap every neighbour of an image is (4 degrees apart).
+  double max_angle_deg = 10.0;
+  // Largest angle, degrees, between a patch normal and the direction to an
+  // image for that image to be a visible view of the patch.
+  double view_angle_deg = 60.0;
+  // Side of the matching window (PMVS2's `wsize`), pixels, odd: the patch
+  // refined by the device, and the smallest adaptive patch.
+  int window_size = 7;
+  // Self-adaptive patch sides tried in order, pixels, odd, decreasing, each
+  // <= kMaxPatchSize; the last must equal window_size (sapmvs mode).
+  std::vector<int> adaptive_sizes = {21, 15, 11, 7};
+  // sapmvs: NCC sample weights. Each sample of a window counts
+  // exp(-d^2 / 2 s^2), d its difference from the window's centre sample in
+  // the reference image and s this many standard deviations of the 3 x 3
+  // samples around the centre, so that a window straddling a wall, a roof
+  // edge or a crown scores the surface under its centre rather than failing
+  // or settling on a depth between the two. Relative, so one value suits
+  // scans and renderings of any contrast; smaller is sharper at edges but
+  // noisier on weak texture (on `small` with 4 features per block, 1.5:
+  // 73.0 % coverage; 3: 72.4 %; NGI keeps 87 % of its points at 3, 76 % at
+  // 2). 0 = plain NCC; pmvs mode always scores plain NCC, as PMVS does.
+  double ncc_sigma_color = 3.0;
+  // Features kept per detector per 32 x 32 pixel block (PMVS: 4). 8 seeds
+  // the roofs that 4 left without a single right seed: on `small` coverage
+  // 72.4 -> 75.5 % (sapmvs) and 63.8 -> 64.9 % (pmvs) at the same accuracy
+  // and time; NGI gains points in both modes.
+  int features_per_block = 8;
+  // Candidate matches lie within this many pixels of the epipolar line.
+  double epipolar_distance = 2.0;
+  // Candidates tried per feature, best ordered first.
+  int candidates_per_feature = 4;
+  // Canny thresholds on 8-bit grey for edge points; edge pixels matched
+  // along epipolar lines become propagation barriers (sapmvs mode).
+  double canny_low = 40;
+  double canny_high = 120;
+  bool use_edges = true;
+  // Expand-then-filter passes (PMVS: n = 3). Each pass after the first frees
+  // the cells of the points the filter removed and grows the surviving
+  // patches into them again.
+  int expand_iterations = 3;
+  // Most candidate patches one device launch takes.
+  int max_wave = 16384;
+  // Waves stop after this many (0 = until the front is empty).
+  int max_waves = 0;
+  // Score fence, in robust standard deviations (1.4826 x MAD): points of a
+  // patch scoring further than this below the median score of the first
+  // expansion's points go (0 = off). Most points are right, so their scores
+  // show what a right match scores on these images (their noise and
+  // texture): about 0.98 on the simulator's, 0.89 on NGI's scans; a fixed
+  // `threshold` (0.7, the floor) cannot be both.
+  double score_fence = 3.0;
+  // Filtering: depth agreement tolerance, in pixel footprints.
+  double depth_tolerance = 3.0;
+  // Neighbourhood test: neighbours within this many footprints of a point.
+  double neighbour_radius = 4.0;
+  // A point needs this many neighbours, and must lie within the plane
+  // tolerance of the plane they fit; a patch's plane must pass within it of
+  // most neighbouring points of other patches. The tolerance is
+  // plane_sigmas robust standard deviations of the distances between
+  // neighbouring patches (how noisy this group's depths are), and at least
+  // plane_tolerance footprints. Half a footprint (one full-resolution GSD at
+  // level 1): a fixed 1.5 let a quarter of the sapmvs points on
+  // `simulate --preset small` stray beyond 1 GSD.
+  int min_neighbours = 4;
+  double plane_tolerance = 0.5;
+  double plane_sigmas = 1.5;
+  // Clusters (points linked within neighbour_radius) smaller than this are
+  // removed.
+  int min_cluster_size = 30;
+  // Show progress on a terminal.
+  bool progress = true;
+
+  // Logs the first failing condition to stderr and returns false.
+  bool Check() const;
+  // The first failing condition as "what was expected (name = value)", or ""
+  // when the options are valid; for callers that report errors themselves.
+  std::string Problem() const;
+};
+
+// The description of every field (option_spec.h): flag, unit, range, help.
+// Fields without a flag are not options of the command line.
+template <class F>
+void VisitFields(MatcherOptions& o, F&& f) {
+  const char* s = "Matching";
+  f(Field(o.mode, "mode").Flag("--mode").In(s).Help("sapmvs (self-adaptive patch) or pmvs"));
+  f(Field(o.level, "level")
+        .Flag("--level")
+        .In(s)
+        .Range(Between(0, kMaxLevel))
+        .Help("Pyramid level: 0 full resolution, 1 half, ..."));
+  f(Field(o.cell_size, "cell_size")
+        .Flag("--csize")
+        .In(s)
+        .Unit("px at the level")
+        .Range(Between(1, 16))
+        .Help("Cell size, pixels at the level"));
+  f(Field(o.threshold, "threshold")
+        .Flag("--threshold")
+        .In(s)
+        .Unit("NCC")
+        .Range(Interval(-1, 1, true, false))
+        .Help("NCC a view needs after optimisation"));
+  f(Field(o.threshold_before, "threshold_before")
+        .Flag("--threshold-before")
+        .In(s)
+        .Unit("NCC")
+        .Range(Interval(-1, 1, true, false))
+        .Rule("<= threshold")
+        .Help("NCC a view needs before optimisation"));
+  f(Field(o.min_image_num, "min_image_num")
+        .Flag("--min-image-num")
+        .In(s)
+        .Unit("images")
+        .Range(Between(2, kMaxViews))
+        .Help("Images a patch must be photo-consistent in"));
+  f(Field(o.max_angle_deg, "max_angle_deg")
+        .Flag("--max-angle")
+        .In(s)
+        .Unit("deg")
+        .Range(Interval(0, 90, false, true))
+        .Help("PMVS2's maxAngle: some pair of a patch's images must meet at more than this, "
+              "degrees"));
+  f(Field(o.view_angle_deg, "view_angle_deg")
+        .Flag("--view-angle")
+        .In(s)
+        .Unit("deg")
+        .Range(Interval(0, 90, true, true))
+        .Help("Largest angle of a view to a patch normal, degrees"));
+  f(Field(o.window_size, "window_size")
+        .Flag("--wsize")
+        .In(s)
+        .Unit("px")
+        .Range(OddBetween(3, kMaxPatchSize))
+        .Help("Matching window, pixels (odd)"));
+  f(Field(o.adaptive_sizes, "adaptive_sizes")
+        .Flag("--adaptive-sizes")
+        .In(s)
+        .Unit("px")
+        .Style(FlagStyle::kList)
+        .Range(OddBetween(3, kMaxPatchSize))
+        .Rule("decreasing, the last = window_size (sapmvs mode)")
+        .Help("sapmvs patch sides, largest first"));
+  f(Field(o.ncc_sigma_color, "ncc_sigma_color")
+        .Flag("--ncc-sigma-color")
+        .In(s)
+        .Unit("SDs")
+        .Range(AtLeast(0))
+        .Help("sapmvs: NCC sample weights, in SDs of the texture at the window's centre (0 = "
+              "plain NCC)"));
+  s = "Seeds and edges";
+  f(Field(o.features_per_block, "features_per_block")
+        .Flag("--features-per-block")
+        .In(s)
+        .Range(AtLeast(1))
+        .Help("Features per detector per 32x32 block"));
+  f(Field(o.epipolar_distance, "epipolar_distance")
+        .Flag("--epipolar-distance")
+        .In(s)
+        .Unit("px")
+        .Range(Above(0))
+        .Help("Seed candidates: pixels from the epipolar line"));
+  f(Field(o.candidates_per_feature, "candidates_per_feature")
+        .Flag("--candidates")
+        .In(s)
+        .Range(AtLeast(1))
+        .Help("Seed candidates tried per feature"));
+  f(Field(o.canny_low, "canny_low")
+        .Flag("--canny-low")
+        .In(s)
+        .Unit("grey levels")
+        .Range(AtLeast(0))
+        .Rule("<= canny_high")
+        .Help("sapmvs: Canny's low threshold on 8-bit grey, for edge points"));
+  f(Field(o.canny_high, "canny_high")
+        .Flag("--canny-high")
+        .In(s)
+        .Unit("grey levels")
+        .Range(Above(0))
+        .Help("sapmvs: Canny's high threshold on 8-bit grey, for edge points"));
+  f(Field(o.use_edges, "use_edges")
+        .Flag("--no-edges")
+        .In(s)
+        .Style(FlagStyle::kNegated)
+        .Help("sapmvs: do not match edges (no propagation barriers)"));
+  s = "Propagation";
+  f(Field(o.max_wave, "max_wave")
+        .Flag("--max-wave")
+        .In(s)
+        .Unit("patches")
+        .Range(AtLeast(1))
+        .Help("Most candidates per device launch"));
+  f(Field(o.max_waves, "max_waves")
+        .Flag("--max-waves")
+        .In(s)
+        .Range(AtLeast(0))
+        .Help("Stop after this many waves (0 = none)"));
+  f(Field(o.expand_iterations, "expand_iterations")
+        .Flag("--expand-iterations")
+        .In(s)
+        .Range(Between(1, 10))
+        .Help("Expand-then-filter passes (PMVS: 3)"));
+  s = "Filter";
+  f(Field(o.score_fence, "score_fence")
+        .Flag("--score-fence")
+        .In(s)
+        .Unit("robust SDs")
+        .Range(AtLeast(0))
+        .Help("Filter: robust SDs below the first pass's median score a point may lie (0 = off)"));
+  f(Field(o.depth_tolerance, "depth_tolerance")
+        .Flag("--depth-tolerance")
+        .In(s)
+        .Unit("footprints")
+        .Range(Above(0))
+        .Help("Filter: depth agreement, pixel footprints"));
+  f(Field(o.neighbour_radius, "neighbour_radius")
+        .Flag("--neighbour-radius")
+        .In(s)
+        .Unit("footprints")
+        .Range(Above(0))
+        .Help("Filter: neighbourhood radius, footprints"));
+  f(Field(o.min_neighbours, "min_neighbours")
+        .Flag("--min-neighbours")
+        .In(s)
+        .Unit("points")
+        .Range(AtLeast(0))
+        .Help("Filter: neighbours a point needs"));
+  f(Field(o.plane_tolerance, "plane_tolerance")
+        .Flag("--plane-tolerance")
+        .In(s)
+        .Unit("footprints")
+        .Range(Above(0))
+        .Help("Filter: distance to the local plane, footprints"));
+  f(Field(o.plane_sigmas, "plane_sigmas")
+        .Flag("--plane-sigmas")
+        .In(s)
+        .Unit("robust SDs")
+        .Range(AtLeast(0))
+        .Help("Filter: plane tolerance in robust SDs of the distances between patches"));
+  f(Field(o.min_cluster_size, "min_cluster_size")
+        .Flag("--min-cluster")
+        .In(s)
+        .Unit("points")
+        .Range(AtLeast(0))
+        .Help("Filter: smallest cluster kept, points"));
+}
+
+}  // namespace sapmvs

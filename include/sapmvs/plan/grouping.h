@@ -1,0 +1,121 @@
+#pragma once
+// Image grouping (method.md 2): a block of hundreds of images does not fit in
+// memory at once, so it is split into small groups that are matched
+// independently and merged. Two strategies:
+//   strip      (paper) runs of at most max_images consecutive images within
+//              one flight strip, the last run of a strip taking the
+//              remainder (16 -> 6+6+4, 17 -> 6+6+5: the paper's Table 3);
+//   footprint  (ours) the ground extent is tiled and each tile gets the
+//              images that see it best, across strips, so that side overlap
+//              also contributes views.
+// Both bound a group by a memory estimate as well as by a count. Groups
+// overlap on the ground; the merge gives each XY to the group whose `center`
+// is nearest.
+#include <Eigen/Core>
+#include <iosfwd>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "sapmvs/block/block.h"
+#include "sapmvs/match/matcher_options.h"
+#include "sapmvs/plan/grouping_options.h"
+
+namespace sapmvs {
+
+struct BlockGeometry;
+
+struct GroupMemory {
+  double device_bytes = 0;
+  double host_bytes = 0;
+  double Total() const { return device_bytes + host_bytes; }
+};
+
+// Memory to match `images` of `block` at `level`, in bytes. With, for image
+// i, P_i its pixels at the level (sides halved per level as
+// Intrinsics::Scaled rounds them) and C_i = ceil(w/c) ceil(h/c) its cells
+// (c = MatcherOptions::cell_size, 2 by default), and M = max_wave:
+//   device = sum_i 8 P_i                      float32 grey, resident for the
+//                                             group, + a float32 depth map
+//          + M (48 + 48 + 4 + 16 (V - 1))     one wave: NccPatch, refined
+//                                             patch, view offset, and per
+//                                             view a pair, an index, a score
+//   host   = sum_i (20 P_i + b C_i)           BGR 8-bit + float32 grey +
+//                                             edge map (mask + float3 point),
+//                                             and per cell b = 17 + 4 (V - 1)
+//                                             + sizeof(AcceptedPatch) +
+//                                             sizeof(DensePoint), about 170:
+//                                             owner + tries, three float depth
+//                                             buffers, at most one accepted
+//                                             patch with its view ids and one
+//                                             dense point
+//          + M (candidate + result + 4 (V - 1))   the wave's host side
+//          + max_i 6 w_i h_i                 loading: one full-resolution
+//                                             BGR image, raw + undistorted
+// with V = kMaxViews and w_i h_i the full-resolution size. The per-image
+// terms grow linearly with the images and by 4x per level towards full
+// resolution; the wave is bounded by max_wave and the loading peak by the
+// largest image, whatever the group. Throws Error for an index outside the
+// block or a level outside 0..6.
+GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images, int level);
+// The same for the cell size, wave size and level of `matcher`.
+GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images,
+                                const MatcherOptions& matcher);
+
+struct ImageGroup {
+  std::vector<int> images;  // indices into block.images, in flight order (strip)
+                            // or best view first (footprint)
+  int strip = -1;           // strip index (strip strategy), else -1
+  // Local-frame XY of the group's ground centre: the mean of its images'
+  // footprint centres (strip), the tile centre (footprint). The merge gives
+  // each XY to the group with the nearest center.
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  // Footprint strategy: the tile, local-frame XY; both zero for strips.
+  Eigen::Vector2d tile_min = Eigen::Vector2d::Zero();
+  Eigen::Vector2d tile_max = Eigen::Vector2d::Zero();
+  GroupMemory memory;
+  // Images of the group whose footprint overlaps (>= 10 %) fewer than
+  // min_image_num - 1 others of it.
+  std::vector<int> short_of_views;
+};
+
+struct GroupingPlan {
+  GroupingStrategy strategy = GroupingStrategy::kStrip;
+  GroupingOptions options;  // what the plan was made with
+  // The matcher it was made for: its level, cell size and wave size (the
+  // memory estimate) and min_image_num (short runs, short_of_views).
+  MatcherOptions matcher;
+  std::vector<std::vector<int>> strips;  // detected strips, images in flight order
+  std::vector<ImageGroup> groups;
+  std::vector<int> ungrouped;  // images in no group (see PlanGroups)
+  // The whole block is one group: it has at most max_images images and fits
+  // memory_budget, and splitting it would only lose views.
+  bool single_group = false;
+};
+
+// Plans the groups of `block`. A block of at most max_images images whose
+// estimate fits memory_budget is one group (single_group), whatever the
+// strategy: `plan` and `run` both show what this returns. Strip strategy: a strip of one image
+// joins the group nearest to it that has room, else it is left ungrouped; a run of one image left
+// at the end of a strip takes one image from the run before it (or shares it, when max_images is
+// 2), so no group has a single image; a block with no strip of 2 or more images (terrestrial,
+// convergent) is cut in block order as one strip, its groups with strip -1. Footprint strategy:
+// images without a surface estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error
+// for bad options, a block of fewer than 2 images, and when 2 images do not fit memory_budget.
+// `matcher`: the options the groups will be matched with. Its level, cell
+// size and wave size set the memory estimate; a strip run shorter than its
+// min_image_num takes the strip images before it, and images of a group that
+// overlap fewer than min_image_num - 1 others of it are reported
+// (short_of_views), since they cannot be matched there.
+// `geometry`: EstimateBlockGeometry(block) when the caller has it (it reads
+// the block's DEM), else nullptr and it is estimated here.
+GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
+                        const MatcherOptions& matcher, const BlockGeometry* geometry = nullptr);
+
+// Like the paper's Table 3: group, image numbers (1-based), image names,
+// number of images, and the memory estimate of each group.
+void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out);
+// The plan as JSON; image indices are 0-based (block order), as in the API.
+nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan);
+
+}  // namespace sapmvs

@@ -1,0 +1,78 @@
+#pragma once
+// The planner's options (GroupingOptions) and their description, apart from
+// the planner (grouping.h). The level the groups are matched at and the
+// views a patch needs are the matcher's (MatcherOptions), which PlanGroups
+// takes beside these.
+#include <string>
+
+#include "sapmvs/util/option_spec.h"
+
+namespace sapmvs {
+
+enum class GroupingStrategy { kStrip, kFootprint };
+std::string ToString(GroupingStrategy s);
+// "strip" or "footprint"; throws sapmvs::Error naming the text and the
+// expected values otherwise.
+GroupingStrategy ParseGroupingStrategy(const std::string& text);
+inline void ParseOptionValue(const std::string& text, GroupingStrategy* strategy) {
+  *strategy = ParseGroupingStrategy(text);
+}
+
+struct GroupingOptions {
+  // The paper's; footprint becomes the default only once it is shown better.
+  GroupingStrategy strategy = GroupingStrategy::kStrip;
+  // Most images per group, >= 2.
+  int max_images = 6;
+  // Bytes that the device + host estimate of one group must fit in.
+  double memory_budget = 8.0 * (1ull << 30);
+  // Footprint strategy: tile side as a share of the median image footprint's
+  // shorter side on the ground, (0, 4]. Smaller tiles give more groups, each
+  // with views chosen for a smaller area.
+  double tile_size = 1.0;
+  // Footprint strategy: images are added to a tile's group until every point
+  // of the tile is seen by this many of them (or max_images is reached),
+  // >= 2.
+  int tile_views = 4;
+
+  // Logs the first failing condition to stderr and returns false.
+  bool Check() const;
+  // "" or the first failing condition as "what was expected (name = value)".
+  std::string Problem() const;
+};
+
+template <class F>
+void VisitFields(GroupingOptions& o, F&& f) {
+  const char* s = "Grouping";
+  f(Field(o.strategy, "strategy")
+        .Flag("--strategy")
+        .In(s)
+        .Help("strip (the paper: runs along flight strips) or footprint (ground tiles)"));
+  f(Field(o.max_images, "max_images")
+        .Flag("--max-images")
+        .In(s)
+        .Unit("images")
+        .Range(AtLeast(2))
+        .Help("Most images per group"));
+  f(Field(o.memory_budget, "memory_budget")
+        .Flag("--memory-budget")
+        .In(s)
+        .Unit("bytes")
+        .Range(Above(0))
+        .Style(FlagStyle::kByteSize)
+        .Help("Device + host memory one group may use: bytes, or 512M, 8G, 1.5G"));
+  f(Field(o.tile_size, "tile_size")
+        .Flag("--tile-size")
+        .In(s)
+        .Unit("footprints")
+        .Range(Interval(0, 4, true, false))
+        .Help("footprint: tile side, in median footprint shorter sides (tiles of at least 64 px "
+              "and at most 100,000 of them)"));
+  f(Field(o.tile_views, "tile_views")
+        .Flag("--tile-views")
+        .In(s)
+        .Unit("images")
+        .Range(AtLeast(2))
+        .Help("footprint: images a tile's points should be seen in"));
+}
+
+}  // namespace sapmvs

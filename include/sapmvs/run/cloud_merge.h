@@ -1,0 +1,62 @@
+#pragma once
+// Merging the clouds of overlapping image groups into one cloud that holds
+// each surface point once (method.md 5.1; the paper keeps the union and does
+// not say how duplicates go).
+//
+// Each group owns a core: the XY points nearer to its ground centre than to
+// any other group's (a Voronoi cell). Points are taken core points first,
+// then by score, best first; a point is dropped when a point already kept
+// from another group lies within `radius` of it (3D). Points of one group are
+// never dropped for each other, so a group's own density stays as matched;
+// a point outside its group's core survives where the owner matched nothing
+// nearby, so group borders get neither seams nor holes.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "sapmvs/io/ply_io.h"
+
+namespace sapmvs {
+
+struct GroupCloud {
+  const PointCloud* cloud = nullptr;
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();  // world XY of the group's ground centre
+};
+
+struct MergeOptions {
+  // Duplicate distance, CRS units (> 0): the caller passes about one ground
+  // sample distance of the level matched, the spacing of the emitted points.
+  double radius = 0;
+  // Empty when usable, else what was expected, naming the value.
+  std::string Problem() const;
+};
+
+struct MergeStats {
+  long input = 0;
+  long kept = 0;
+  long duplicates = 0;              // dropped: another group's point within radius
+  std::vector<long> kept_by_group;  // in the order of the groups given
+  std::vector<long> core_by_group;  // of those, inside the group's own core
+};
+
+// The merged cloud takes crs and the has_* flags from the first group (all
+// groups of one run agree). Deterministic: the same inputs give the same
+// points in the same order. Throws sapmvs::Error for bad options.
+PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOptions& options,
+                            MergeStats* stats = nullptr);
+
+// The index of the centre nearest to (x, y): the core owner; -1 for none.
+int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);
+
+// Pairs of points of different groups (group_of[i] is point i's group) within
+// `radius` of each other (3D): what the merge leaves none of. radius > 0.
+long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of, double radius);
+
+// How many points of `from` have a point of `to` within `radius` (3D): one
+// cloud's coverage of another, as profiling/versus_pmvs2 compares clouds of
+// different matchers. radius > 0. `has`, if given, receives the answer per
+// point of `from`.
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
+                        std::vector<bool>* has = nullptr);
+
+}  // namespace sapmvs

@@ -1,0 +1,88 @@
+#pragma once
+// What `sapmvs run` is asked to do (RunOptions), apart from the run
+// (dense_run.h) so that its report and checkpoints can take it.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/las_io.h"
+#include "sapmvs/match/matcher_options.h"
+#include "sapmvs/plan/grouping_options.h"
+#include "sapmvs/run/cloud_dsm.h"
+#include "sapmvs/util/option_spec.h"
+
+namespace sapmvs {
+
+inline void ParseOptionValue(const std::string& text, LasVersion* version) {
+  *version = ParseLasVersion(text);
+}
+
+struct RunOptions {
+  std::filesystem::path block;  // any format ReadBlock takes
+  // How to read it (format, image folder, size check, ground height).
+  BlockReadOptions read;
+  std::filesystem::path out;  // output folder, created when missing
+  // OpenCL device: index or name substring, or "reference" for the CPU
+  // reference backend ("" = SAPMVS_DEVICE, else the default OpenCL device).
+  std::string device;
+  MatcherOptions matcher;
+  // The plan is made for `matcher` (its level and min_image_num).
+  GroupingOptions grouping;
+  // Discard DIR/groups/ and start over instead of resuming.
+  bool restart = false;
+  // Match at most this many groups in this call, then stop (resumable);
+  // 0 = all. For splitting a long run into sessions.
+  int max_groups = 0;
+  // Merge: a point is a duplicate of another group's point within this many
+  // ground sample distances of the matched level. > 0.
+  double merge_radius_gsd = 1.0;
+  DsmOptions dsm;
+  // cloud.las: LAS 1.2 by default, which every reader opens (las_io.h).
+  LasVersion las_version = LasWriteOptions{}.version;
+  // Profile the device queue (CL_QUEUE_PROFILING_ENABLE; the reference's
+  // wall clock): kernel device times in the report, and the profile tables
+  // (run_profile.h).
+  bool profile = false;
+  // Not an option: the command line that asked for the run, for report.json.
+  std::vector<std::string> command_line;
+
+  // Empty when usable, else what was expected, naming the value.
+  std::string Problem() const;
+  bool Check() const;
+};
+
+// The run's own flags (option_spec.h); the matcher's, the grouping's and the
+// DSM's are described beside their structs. `block` and `out` are arguments
+// rather than tunables, and --profile also names a file: cli_run.cc adds
+// those three.
+template <class F>
+void VisitFields(RunOptions& o, F&& f) {
+  f(Field(o.device, "device")
+        .Flag("--device")
+        .In("Device")
+        .Help("OpenCL device: index or name substring (see `sapmvs devices`), or "
+              "`reference` for the CPU reference (no OpenCL)"));
+  f(Field(o.restart, "restart")
+        .Flag("--restart")
+        .In("Output and resume")
+        .Help("Discard the checkpoints in DIR/groups and start over"));
+  f(Field(o.max_groups, "max_groups")
+        .Flag("--max-groups")
+        .In("Output and resume")
+        .Unit("groups")
+        .Range(AtLeast(0))
+        .Help("Match at most this many groups now, then stop (resumable; 0 = all)"));
+  f(Field(o.merge_radius_gsd, "merge_radius_gsd")
+        .Flag("--merge-radius")
+        .In("Merge and DSM")
+        .Unit("GSDs")
+        .Range(Above(0))
+        .Help("Merge: duplicate distance, GSDs of the level matched"));
+  f(Field(o.las_version, "las_version")
+        .Flag("--las-version")
+        .In("Merge and DSM")
+        .Help("cloud.las: 1.2 (format 2, every reader opens it) or 1.4 (format 7)"));
+}
+
+}  // namespace sapmvs

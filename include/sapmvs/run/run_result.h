@@ -1,0 +1,61 @@
+#pragma once
+// What a `sapmvs run` did (RunReport): groups, device, statistics, merge,
+// times. The run fills it; report.json, the summary and the profile read it.
+#include <Eigen/Core>
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sapmvs/match/match_stats.h"
+#include "sapmvs/run/cloud_merge.h"
+
+namespace sapmvs {
+
+struct GroupRun {
+  int index = 0;  // 0-based
+  std::vector<std::string> images;
+  long points = 0;
+  double seconds = 0;
+  bool resumed = false;  // read from a checkpoint of an earlier call
+};
+
+// The device a run used (an OpenCL device or the CPU reference), as
+// report.json names it.
+struct RunDevice {
+  std::string name;      // CL_DEVICE_NAME, or "reference"
+  std::string vendor;    // CL_DEVICE_VENDOR
+  std::string platform;  // CL_PLATFORM_NAME and CL_PLATFORM_VERSION
+  std::string type;      // "GPU", "CPU" or "other"
+};
+
+struct RunReport {
+  std::filesystem::path out;
+  std::string device;  // one line, as `sapmvs devices` describes it
+  RunDevice device_info;
+  std::chrono::system_clock::time_point start_time, end_time;
+  std::string strategy;
+  bool finished = false;  // false: stopped by max_groups, outputs not written
+  int images = 0;
+  std::vector<GroupRun> groups;
+  std::vector<std::string> ungrouped;  // images the plan put in no group (grouping.h)
+  MatchStats stats;                    // summed over the groups matched in this call
+  MergeStats merge;
+  long points = 0;
+  double mean_spacing = 0;  // mean nearest-neighbour distance, CRS units
+  double density = 0;       // points per CRS unit squared of covered ground
+  double area = 0;
+  double dsm_cell = 0;
+  // The merged cloud's bounding box, world (CRS) coordinates.
+  Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bounds_max = Eigen::Vector3d::Zero();
+  double total_seconds = 0;
+  double peak_rss_bytes = 0;
+  std::vector<std::pair<std::string, double>> stages;  // wall seconds, this call
+};
+
+// Seconds as h:min:s, as the paper's tables give run times.
+std::string FormatHms(double seconds);
+
+}  // namespace sapmvs
