@@ -38,7 +38,8 @@ if [ "${1:-}" = "--sanitize" ]; then
     cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_COMPILER=g++ \
       -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1 -fno-omit-frame-pointer $san" \
       -DCMAKE_EXE_LINKER_FLAGS_SANITIZE="-fsanitize=address,undefined,float-cast-overflow" \
-      -DSAPMVS_BUILD_BENCHMARKS=OFF -DSAPMVS_TESTS_HOST_ONLY=ON "${launcher[@]}" >/dev/null
+      -DSAPMVS_BUILD_BENCHMARKS=OFF -DSAPMVS_TESTS_HOST_ONLY=ON -DSAPMVS_UNITY_BUILD=ON \
+      "${launcher[@]}" >/dev/null
   fi
   cmake --build "$build" --target sapmvs_tests -j"$jobs"
   built=$(date +%s)

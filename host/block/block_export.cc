@@ -16,6 +16,7 @@
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/number_text.h"
 #include "sapmvs/util/progress.h"
 
 namespace sapmvs {
@@ -139,19 +140,14 @@ bool IsInside(const fs::path& file, const fs::path& dir) {
   return std::mismatch(f.begin(), f.end(), d.begin(), d.end()).second == d.end();
 }
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
 // P = K [R | t] of the undistorted image, PMVS's pixel convention being ours
 // (pixel centres at integers).
 std::string PmvsCameraText(const Camera& local) {
   const Eigen::Matrix<double, 3, 4> p = local.ProjectionMatrix();
   std::string s = "CONTOUR\n";
   for (int r = 0; r < 3; ++r) {
-    s += Num(p(r, 0)) + " " + Num(p(r, 1)) + " " + Num(p(r, 2)) + " " + Num(p(r, 3)) + "\n";
+    s += FormatNumber(p(r, 0), 17) + " " + FormatNumber(p(r, 1), 17) + " " +
+         FormatNumber(p(r, 2), 17) + " " + FormatNumber(p(r, 3), 17) + "\n";
   }
   return s;
 }
@@ -186,10 +182,11 @@ ColmapText ColmapModelText(const std::vector<ExportImage>& plan, const Eigen::Ve
     Eigen::Quaterniond q(local.rotation());
     if (q.w() < 0) q.coeffs() = -q.coeffs();  // COLMAP's convention: qw >= 0
     const Eigen::Vector3d t = -(local.rotation() * local.center());
-    lines += std::to_string(i + 1) + " " + Num(q.w()) + " " + Num(q.x()) + " " + Num(q.y()) + " " +
-             Num(q.z()) + " " + Num(t.x()) + " " + Num(t.y()) + " " + Num(t.z()) + " " +
-             std::to_string(cam - cameras.begin() + 1) + " " + plan[i].file.filename().string() +
-             "\n\n";
+    lines += std::to_string(i + 1) + " " + FormatNumber(q.w(), 17) + " " + FormatNumber(q.x(), 17) +
+             " " + FormatNumber(q.y(), 17) + " " + FormatNumber(q.z(), 17) + " " +
+             FormatNumber(t.x(), 17) + " " + FormatNumber(t.y(), 17) + " " +
+             FormatNumber(t.z(), 17) + " " + std::to_string(cam - cameras.begin() + 1) + " " +
+             plan[i].file.filename().string() + "\n\n";
   }
   ColmapText text;
   text.num_cameras = static_cast<int>(cameras.size());
@@ -201,8 +198,9 @@ ColmapText ColmapModelText(const std::vector<ExportImage>& plan, const Eigen::Ve
   for (size_t c = 0; c < cameras.size(); ++c) {
     const Intrinsics& k = cameras[c];
     text.cameras += std::to_string(c + 1) + " PINHOLE " + std::to_string(k.width) + " " +
-                    std::to_string(k.height) + " " + Num(k.fx) + " " + Num(k.fy) + " " +
-                    Num(k.cx + 0.5) + " " + Num(k.cy + 0.5) + "\n";
+                    std::to_string(k.height) + " " + FormatNumber(k.fx, 17) + " " +
+                    FormatNumber(k.fy, 17) + " " + FormatNumber(k.cx + 0.5, 17) + " " +
+                    FormatNumber(k.cy + 0.5, 17) + "\n";
   }
   text.images =
       "# Image list with two lines of data per image:\n"
@@ -224,8 +222,8 @@ std::string ColmapPointsText(const std::vector<Eigen::Vector3d>& points,
       std::to_string(points.size()) + ", mean track length: 0\n";
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d p = points[i] - origin;
-    s += std::to_string(i + 1) + " " + Num(p.x()) + " " + Num(p.y()) + " " + Num(p.z()) +
-         " 128 128 128 0\n";
+    s += std::to_string(i + 1) + " " + FormatNumber(p.x(), 17) + " " + FormatNumber(p.y(), 17) +
+         " " + FormatNumber(p.z(), 17) + " 128 128 128 0\n";
   }
   return s;
 }

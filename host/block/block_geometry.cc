@@ -8,11 +8,11 @@
 
 #include "sapmvs/block/dem.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Fewer tie points than this over a whole block are chance matches, not a
 // surface.
 constexpr size_t kMinTiePoints = 20;

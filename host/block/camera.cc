@@ -5,11 +5,10 @@
 #include <limits>
 
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 void RequirePositive(double v, const char* name, const std::string& what) {
   if (!std::isfinite(v) || v <= 0) {

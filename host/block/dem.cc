@@ -8,12 +8,11 @@
 #include <memory>
 
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 #include "util/input_file.h"
 
 namespace sapmvs {
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}
+namespace {}
 
 Dem Dem::Load(const std::filesystem::path& path) {
   RequireRegularFile(path);

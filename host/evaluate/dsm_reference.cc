@@ -6,18 +6,10 @@
 #include <sstream>
 
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
 
 // Continuous cell coordinate along one axis (0 = the first centre), clamped
 // to the centres; false outside [-0.5, n - 0.5].
@@ -71,7 +63,8 @@ DsmFootprint FootprintFromBox(const GeoRaster& dsm, double xmin, double ymin, do
           !dsm.IsEmpty(c, r) && p.x() >= xmin && p.x() <= xmax && p.y() >= ymin && p.y() <= ymax;
     }
   }
-  f.note = "box X " + Num(xmin) + " .. " + Num(xmax) + ", Y " + Num(ymin) + " .. " + Num(ymax);
+  f.note = "box X " + FormatNumber(xmin, 10) + " .. " + FormatNumber(xmax, 10) + ", Y " +
+           FormatNumber(ymin, 10) + " .. " + FormatNumber(ymax, 10);
   return f;
 }
 

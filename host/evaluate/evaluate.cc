@@ -12,16 +12,10 @@
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/io/raster_io.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
 
 std::string LowerExtension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -89,15 +83,16 @@ std::string EvaluateOptions::Problem() const {
   if (cloud.empty()) return "no cloud given (expected a .ply, .las or .xyz file)";
   if (reference.empty()) return "no --reference given (expected LiDAR points or a DSM raster)";
   if (!(radius >= 0) || !std::isfinite(radius)) {
-    return "--radius " + Num(radius) +
+    return "--radius " + FormatNumber(radius, 10) +
            ": expected a positive distance in CRS units, or 0 to derive it from the LiDAR";
   }
   if (!(tolerance > 0) || !std::isfinite(tolerance)) {
-    return "--tolerance " + Num(tolerance) + ": expected a positive distance in CRS units";
+    return "--tolerance " + FormatNumber(tolerance, 10) +
+           ": expected a positive distance in CRS units";
   }
   for (double t : drop_above) {
     if (!(t > 0) || !std::isfinite(t)) {
-      return "--drop-above " + Num(t) + ": expected positive thresholds in CRS units";
+      return "--drop-above " + FormatNumber(t, 10) + ": expected positive thresholds in CRS units";
     }
   }
   if (!footprint.empty()) {
@@ -108,8 +103,9 @@ std::string EvaluateOptions::Problem() const {
     if (!(footprint[0] < footprint[2] && footprint[1] < footprint[3]) ||
         !std::all_of(footprint.begin(), footprint.end(),
                      [](double v) { return std::isfinite(v); })) {
-      return "--footprint " + Num(footprint[0]) + "," + Num(footprint[1]) + "," +
-             Num(footprint[2]) + "," + Num(footprint[3]) +
+      return "--footprint " + FormatNumber(footprint[0], 10) + "," +
+             FormatNumber(footprint[1], 10) + "," + FormatNumber(footprint[2], 10) + "," +
+             FormatNumber(footprint[3], 10) +
              ": expected finite xmin,ymin,xmax,ymax with xmin < xmax and ymin < ymax";
     }
     if (!block.empty()) return "--footprint and --block both given (expected one of them)";
@@ -208,10 +204,11 @@ EvaluationReport EvaluateAgainstLidar(std::vector<Eigen::Vector3d> cloud,
     // The mean over thousands of LiDAR points is no height at a point, and
     // each query would cost as many.
     if (std::isfinite(r.spacing) && options.radius > kMaxRadiusPerSpacing * r.spacing) {
-      throw Error("evaluate: --radius " + Num(options.radius) + " is " +
-                  Num(std::round(options.radius / r.spacing)) + " x the LiDAR's point spacing (" +
-                  Num(r.spacing) + "); expected at most " + Num(kMaxRadiusPerSpacing) +
-                  " x (--radius <= " + Num(kMaxRadiusPerSpacing * r.spacing) + ")");
+      throw Error("evaluate: --radius " + FormatNumber(options.radius, 10) + " is " +
+                  FormatNumber(std::round(options.radius / r.spacing), 10) +
+                  " x the LiDAR's point spacing (" + FormatNumber(r.spacing, 10) +
+                  "); expected at most " + FormatNumber(kMaxRadiusPerSpacing, 10) +
+                  " x (--radius <= " + FormatNumber(kMaxRadiusPerSpacing * r.spacing, 10) + ")");
     }
     r.radius = options.radius;
     r.radius_note = "given with --radius";
@@ -222,7 +219,8 @@ EvaluationReport EvaluateAgainstLidar(std::vector<Eigen::Vector3d> cloud,
                   "give --radius");
     }
     r.radius = kRadiusPerSpacing * r.spacing;
-    r.radius_note = Num(kRadiusPerSpacing) + " x the LiDAR's median nearest-neighbour XY spacing";
+    r.radius_note =
+        FormatNumber(kRadiusPerSpacing, 10) + " x the LiDAR's median nearest-neighbour XY spacing";
   }
   const std::vector<double> heights = reference.MeanHeights(cloud, r.radius, !options.quiet);
   r.points = std::move(cloud);

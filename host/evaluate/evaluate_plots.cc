@@ -13,6 +13,7 @@
 #include "sapmvs/evaluate/evaluate.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
@@ -33,12 +34,6 @@ constexpr double kRangeQuantile = 0.95;
 
 const cv::Scalar kBlack(0, 0, 0), kWhite(255, 255, 255), kGrey(200, 200, 200), kRed(0, 0, 220),
     kBlue(200, 120, 40), kGreen(60, 160, 60);
-
-std::string Fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
 
 void Text(cv::Mat* img, const std::string& text, int x, int y, double scale = 0.45,
           const cv::Scalar& color = kBlack) {
@@ -164,12 +159,12 @@ struct MapFrame {
     for (double x = std::ceil(min.x() / step) * step; x <= max.x(); x += step) {
       const int px = kMarginLeft + static_cast<int>(std::lround((x - min.x()) * scale));
       cv::line(img, {px, kMarginTop + height}, {px, kMarginTop + height + 5}, kBlack);
-      Text(&img, Fmt("%.10g", x), px - 25, kMarginTop + height + 20, 0.4);
+      Text(&img, FormatPrintf("%.10g", x), px - 25, kMarginTop + height + 20, 0.4);
     }
     for (double y = std::ceil(min.y() / step) * step; y <= max.y(); y += step) {
       const int py = kMarginTop + static_cast<int>(std::lround((max.y() - y) * scale));
       cv::line(img, {kMarginLeft - 6, py}, {kMarginLeft - 1, py}, kBlack);
-      Text(&img, Fmt("%.10g", y), 4, py + 4, 0.4);
+      Text(&img, FormatPrintf("%.10g", y), 4, py + 4, 0.4);
     }
     Text(&img, "X, east" + unit + "; north up", kMarginLeft, kMarginTop + height + 42);
     Text(&img, "Y" + unit, 4, kMarginTop - 8);
@@ -212,7 +207,7 @@ cv::Mat Histogram(const EvaluationReport& r, double range) {
   for (int k = -2; k <= 2; ++k) {
     const double v = range * k / 2;
     cv::line(img, {x_of(v), kMarginTop + h}, {x_of(v), kMarginTop + h + 5}, kBlack);
-    Text(&img, Fmt("%g", v), x_of(v) - 15, kMarginTop + h + 22);
+    Text(&img, FormatPrintf("%g", v), x_of(v) - 15, kMarginTop + h + 22);
   }
   Text(&img, std::to_string(peak), 5, kMarginTop + 10);
   Text(&img, "0", 5, kMarginTop + h);
@@ -221,8 +216,8 @@ cv::Mat Histogram(const EvaluationReport& r, double range) {
   Text(&img, "dz = Z - Z_ref" + Unit(r, true), kMarginLeft + w / 2 - 70, kMarginTop + h + 42);
   Text(&img, "dz of " + std::to_string(n) + " checkpoints (no threshold)", kMarginLeft, 22, 0.55);
   Text(&img,
-       "values beyond +-" + Fmt("%g", range) + " are counted in the end bins; green: +-tolerance " +
-           Fmt("%g", r.tolerance),
+       "values beyond +-" + FormatPrintf("%g", range) +
+           " are counted in the end bins; green: +-tolerance " + FormatPrintf("%g", r.tolerance),
        kMarginLeft, 44);
   return img;
 }
@@ -267,12 +262,13 @@ cv::Mat ErrorMap(const EvaluationReport& r, double range) {
   for (int k = -2; k <= 2; ++k) {
     const int y = kMarginTop + static_cast<int>(std::lround((bar_h - 1) * (2 - k) / 4.0));
     cv::line(img, {x0 + 21, y}, {x0 + 26, y}, kBlack);
-    Text(&img, Fmt("%+g", range * k / 2), x0 + 30, y + 5);
+    Text(&img, FormatPrintf("%+g", range * k / 2), x0 + 30, y + 5);
   }
   Text(&img, "dz" + Unit(r, true), x0 - 10, kMarginTop - 10);
   Text(&img,
-       "mean dz per " + Fmt("%.3g", dz.f / frame.scale) + " " +
-           (r.unit.empty() ? "CRS units" : r.unit) + " cell, clipped to +-" + Fmt("%g", range),
+       "mean dz per " + FormatPrintf("%.3g", dz.f / frame.scale) + " " +
+           (r.unit.empty() ? "CRS units" : r.unit) + " cell, clipped to +-" +
+           FormatPrintf("%g", range),
        kMarginLeft, 22, 0.55);
   Text(&img, "dark grey: no reference height", kMarginLeft, 44);
   return img;
@@ -280,11 +276,12 @@ cv::Mat ErrorMap(const EvaluationReport& r, double range) {
 
 cv::Mat PseudoErrorMap(const EvaluationReport& r) {
   double t = r.tolerance;
-  std::string what = "|dz| > tolerance " + Fmt("%g", t) + " (no --drop-above given)";
+  std::string what = "|dz| > tolerance " + FormatPrintf("%g", t) + " (no --drop-above given)";
   if (r.rows.size() > 1) {
     t = 0;
     for (size_t i = 1; i < r.rows.size(); ++i) t = std::max(t, r.rows[i].threshold);
-    what = "|dz| > " + Fmt("%g", t) + ", dropped as pseudo-errors by the largest threshold";
+    what =
+        "|dz| > " + FormatPrintf("%g", t) + ", dropped as pseudo-errors by the largest threshold";
   }
   const MapFrame frame(r.points);
   cv::Mat img = frame.Canvas(Unit(r, false));

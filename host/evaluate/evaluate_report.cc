@@ -11,23 +11,21 @@
 #include "sapmvs/evaluate/evaluate.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
 
-std::string Fmt(const char* format, double v) {
-  if (std::isnan(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
+std::string FmtOrDash(const char* format, double v) {
+  return std::isnan(v) ? "-" : FormatPrintf(format, v);
 }
 
 std::string Percent(long part, long whole) {
-  return whole > 0 ? Fmt("%.2f%%", 100.0 * part / whole) : "-";
+  return whole > 0 ? FmtOrDash("%.2f%%", 100.0 * part / whole) : "-";
 }
 
 std::string ThresholdLabel(double t) {
-  return std::isinf(t) ? std::string("none") : "|dz| <= " + Fmt("%g", t);
+  return std::isinf(t) ? std::string("none") : "|dz| <= " + FmtOrDash("%g", t);
 }
 
 // A value that JSON can hold: NaN and infinities become null.
@@ -40,37 +38,37 @@ void PrintEvaluationTable(const EvaluationReport& r, std::ostream& out) {
   out << "cloud         " << r.cloud.string() << ": " << r.cloud_points << " points\n";
   if (lidar) {
     out << "reference     " << r.reference.string() << ": LiDAR, " << r.reference_points
-        << " points, median nearest-neighbour XY spacing " << Fmt("%.4g", r.spacing) << "\n";
-    out << "radius d      " << Fmt("%.4g", r.radius) << " (" << r.radius_note << ")\n";
+        << " points, median nearest-neighbour XY spacing " << FmtOrDash("%.4g", r.spacing) << "\n";
+    out << "radius d      " << FmtOrDash("%.4g", r.radius) << " (" << r.radius_note << ")\n";
   } else {
     out << "reference     " << r.reference.string() << ": DSM, " << r.dsm_width << " x "
-        << r.dsm_height << " cells of " << Fmt("%.4g", r.dsm_cell_size) << ", "
+        << r.dsm_height << " cells of " << FmtOrDash("%.4g", r.dsm_cell_size) << ", "
         << r.reference_points << " non-empty; heights bilinear between cell centres\n";
   }
-  out << "tolerance     " << Fmt("%g", r.tolerance) << " (CRS units)\n";
+  out << "tolerance     " << FmtOrDash("%g", r.tolerance) << " (CRS units)\n";
   out << "no reference  " << r.without_reference << " of " << r.cloud_points << " points ("
       << Percent(r.without_reference, r.cloud_points) << ") "
       << (lidar ? "have no LiDAR point within d" : "lie outside the DSM or next to empty cells")
       << "; they are not checkpoints\n";
   out << "\n";
   char line[256];
-  const std::string within = "within " + Fmt("%g", r.tolerance);
+  const std::string within = "within " + FmtOrDash("%g", r.tolerance);
   std::snprintf(line, sizeof line, "%-16s %12s %12s %12s %12s %12s %12s\n", "threshold",
                 "checkpoints", "RMSE", "max", "mean", "median |dz|", within.c_str());
   out << line;
   for (const ErrorRow& row : r.rows) {
     std::snprintf(line, sizeof line, "%-16s %12ld %12s %12s %12s %12s %12s\n",
                   ThresholdLabel(row.threshold).c_str(), row.checkpoints,
-                  Fmt("%.6f", row.rmse).c_str(), Fmt("%.6f", row.max_abs).c_str(),
-                  Fmt("%.6f", row.mean).c_str(), Fmt("%.6f", row.median_abs).c_str(),
-                  Fmt("%.1f%%", 100 * row.within).c_str());
+                  FmtOrDash("%.6f", row.rmse).c_str(), FmtOrDash("%.6f", row.max_abs).c_str(),
+                  FmtOrDash("%.6f", row.mean).c_str(), FmtOrDash("%.6f", row.median_abs).c_str(),
+                  FmtOrDash("%.1f%%", 100 * row.within).c_str());
     out << line;
   }
   if (r.completeness) {
     const Completeness& c = *r.completeness;
-    out << "\ncompleteness  " << Fmt("%.1f%%", 100 * c.share) << ": " << c.filled << " of "
+    out << "\ncompleteness  " << FmtOrDash("%.1f%%", 100 * c.share) << ": " << c.filled << " of "
         << c.cells << " non-empty DSM cells in the footprint hold a point within "
-        << Fmt("%g", r.tolerance) << "\nfootprint     " << c.footprint << "\n";
+        << FmtOrDash("%g", r.tolerance) << "\nfootprint     " << c.footprint << "\n";
   }
 }
 

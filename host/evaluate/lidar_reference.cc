@@ -7,12 +7,12 @@
 #include <limits>
 
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 #include "sapmvs/util/progress.h"
 
 namespace sapmvs {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Queries per FLANN call: bounds the memory of the per-query result vectors.
 constexpr size_t kChunkQueries = 1 << 16;
 // Candidates (index + distance, 12 bytes each) one FLANN call may return,

@@ -1,4 +1,5 @@
 #include "io/las_extra_bytes.h"
+#include "sapmvs/util/number_text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -55,13 +56,6 @@ std::pair<double, double> Range(LasExtraType type) {
   return {0, 0};
 }
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 size_t ExtraTypeSize(LasExtraType type) {
@@ -104,9 +98,9 @@ std::string ExtraFieldsProblem(const std::vector<LasExtraField>& fields, size_t 
     for (size_t i = 0; i < points; ++i) {
       const double v = f.values[i];
       if (!std::isfinite(v) || v < lo || v > hi || (!IsFloat(f.type) && v != std::floor(v))) {
-        return label + ", point " + std::to_string(i) + ": value " + Num(v) + " (expected " +
-               (IsFloat(f.type) ? "a finite number" : "a whole number") + " from " + Num(lo) +
-               " to " + Num(hi) + ")";
+        return label + ", point " + std::to_string(i) + ": value " + FormatNumber(v, 17) +
+               " (expected " + (IsFloat(f.type) ? "a finite number" : "a whole number") + " from " +
+               FormatNumber(lo, 17) + " to " + FormatNumber(hi, 17) + ")";
       }
     }
   }

@@ -15,6 +15,7 @@
 #include "sapmvs/io/raster_io.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 #include "util/input_file.h"
 
 namespace sapmvs {
@@ -58,13 +59,6 @@ double Dequantize(int32_t q, double scale, double offset) {
   return static_cast<double>(q) * scale + offset;
 }
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(12);
-  s << v;
-  return s.str();
-}
-
 // 10^exponent as the double nearest the decimal (0.001, not 0.001 * 10 * 10),
 // so that headers show round scales.
 double DecimalScale(int exponent) {
@@ -98,9 +92,10 @@ Quantization ChooseQuantization(const std::filesystem::path& path,
     if (user_scale > 0) {
       q.scale[a] = user_scale;
       if (reach / user_scale > kMaxQuantized) {
-        throw Error(path.string() + ": " + kAxis[a] + " spans " + Num(lo) + " to " + Num(hi) +
-                    ", too wide for scale " + Num(user_scale) +
-                    " in int32 (expected a scale >= " + Num(reach / kMaxQuantized) + ")");
+        throw Error(path.string() + ": " + kAxis[a] + " spans " + FormatNumber(lo, 12) + " to " +
+                    FormatNumber(hi, 12) + ", too wide for scale " + FormatNumber(user_scale, 12) +
+                    " in int32 (expected a scale >= " + FormatNumber(reach / kMaxQuantized, 12) +
+                    ")");
       }
     } else {
       // ~1 cm on the ground for degrees; mm for metres.
@@ -127,8 +122,8 @@ void CheckPoints(const std::filesystem::path& path, const std::vector<PointRecor
     const PointRecord& p = points[i];
     const std::string at = path.string() + ": point " + std::to_string(i);
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw Error(at + " is (" + Num(p.x) + ", " + Num(p.y) + ", " + Num(p.z) +
-                  "); expected finite coordinates");
+      throw Error(at + " is (" + FormatNumber(p.x, 12) + ", " + FormatNumber(p.y, 12) + ", " +
+                  FormatNumber(p.z, 12) + "); expected finite coordinates");
     }
     if (p.return_number > max_return || p.number_of_returns > max_return) {
       throw Error(at + " has return " + std::to_string(p.return_number) + " of " +
@@ -314,7 +309,8 @@ std::string ToString(LasVersion version) { return version == LasVersion::k12 ? "
 
 std::string LasWriteOptions::Problem() const {
   if (!(scale >= 0) || !std::isfinite(scale)) {
-    return "LAS scale " + Num(scale) + ": expected a positive resolution, or 0 to choose one";
+    return "LAS scale " + FormatNumber(scale, 12) +
+           ": expected a positive resolution, or 0 to choose one";
   }
   if (creation_day < 0 || creation_day > 366 || creation_year < 0 || creation_year > 65535) {
     return "LAS creation day " + std::to_string(creation_day) + " / year " +
@@ -462,8 +458,9 @@ LasCloud ReadLas(const std::filesystem::path& path, bool extra_values) {
     cloud.scale[a] = Get<double>(&h[131 + 8 * a]);
     cloud.offset[a] = Get<double>(&h[155 + 8 * a]);
     if (!std::isfinite(cloud.scale[a]) || cloud.scale[a] == 0 || !std::isfinite(cloud.offset[a])) {
-      throw fail("scale " + Num(cloud.scale[a]) + " / offset " + Num(cloud.offset[a]) + " of " +
-                 "XYZ"[a] + " (expected a finite, non-zero scale and a finite offset)");
+      throw fail("scale " + FormatNumber(cloud.scale[a], 12) + " / offset " +
+                 FormatNumber(cloud.offset[a], 12) + " of " + "XYZ"[a] +
+                 " (expected a finite, non-zero scale and a finite offset)");
     }
   }
   if (point_offset < header_size || point_offset > size) {

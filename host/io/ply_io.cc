@@ -25,7 +25,7 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "PLY I/O assumes a litt
 constexpr size_t kMaxHeaderLineLength = 1 << 16;
 constexpr int kMaxHeaderLines = 100000;
 // Points per write call and bytes per read refill: a few MB at most.
-constexpr size_t kChunkPoints = 1 << 16;
+constexpr size_t kPlyChunkPoints = 1 << 16;
 constexpr size_t kReadBufferSize = 1 << 20;
 
 enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
@@ -543,8 +543,8 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud) {
     const std::string text = header.str();
     out.write(text.data(), static_cast<std::streamsize>(text.size()));
     std::vector<uint8_t> buffer;
-    for (size_t first = 0; first < cloud.points.size(); first += kChunkPoints) {
-      const size_t n = std::min(kChunkPoints, cloud.points.size() - first);
+    for (size_t first = 0; first < cloud.points.size(); first += kPlyChunkPoints) {
+      const size_t n = std::min(kPlyChunkPoints, cloud.points.size() - first);
       buffer.resize(n * record);
       uint8_t* b = buffer.data();
       auto put = [&b](const void* v, size_t size) {

@@ -15,6 +15,7 @@
 
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 #include "util/gdal_messages.h"
 
 namespace sapmvs {
@@ -47,13 +48,6 @@ struct GdalDatasetCloser {
 };
 using DatasetPtr = std::unique_ptr<GDALDataset, GdalDatasetCloser>;
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(12);
-  s << v;
-  return s.str();
-}
-
 void CheckRaster(const std::filesystem::path& path, const GeoRaster& r) {
   const std::string file = path.string();
   if (r.width <= 0 || r.height <= 0) {
@@ -65,11 +59,12 @@ void CheckRaster(const std::filesystem::path& path, const GeoRaster& r) {
                 std::to_string(r.width) + " x " + std::to_string(r.height));
   }
   if (!(r.cell_size > 0) || !std::isfinite(r.cell_size)) {
-    throw Error(file + ": cell size " + Num(r.cell_size) + " (expected a positive number)");
+    throw Error(file + ": cell size " + FormatNumber(r.cell_size, 12) +
+                " (expected a positive number)");
   }
   if (!std::isfinite(r.origin_x) || !std::isfinite(r.origin_y)) {
-    throw Error(file + ": raster origin (" + Num(r.origin_x) + ", " + Num(r.origin_y) +
-                ") (expected finite coordinates)");
+    throw Error(file + ": raster origin (" + FormatNumber(r.origin_x, 12) + ", " +
+                FormatNumber(r.origin_y, 12) + ") (expected finite coordinates)");
   }
 }
 
@@ -282,8 +277,8 @@ GeoRaster ReadGeoRaster(const std::filesystem::path& path) {
   const double dx = geo[1], dy = std::abs(geo[5]);
   if (!(dx > 0) || !(dy > 0) || std::abs(dx - dy) > 1e-9 * dx) {
     throw InputError(file, 0,
-                     "expected square cells with columns running east, got cell size " + Num(dx) +
-                         " x " + Num(geo[5]));
+                     "expected square cells with columns running east, got cell size " +
+                         FormatNumber(dx, 12) + " x " + FormatNumber(geo[5], 12));
   }
   const bool south_up = geo[5] > 0;
   r.cell_size = dx;

@@ -8,24 +8,19 @@
 #include "sapmvs/io/las_io.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 #include "util/text_lines.h"
 
 namespace sapmvs {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(12);
-  s << v;
-  return s.str();
-}
-
 void CheckPoints(const std::filesystem::path& path, const std::vector<PointRecord>& points) {
   for (size_t i = 0; i < points.size(); ++i) {
     const PointRecord& p = points[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw Error(path.string() + ": point " + std::to_string(i) + " is (" + Num(p.x) + ", " +
-                  Num(p.y) + ", " + Num(p.z) + "); expected finite coordinates");
+      throw Error(path.string() + ": point " + std::to_string(i) + " is (" + FormatNumber(p.x, 12) +
+                  ", " + FormatNumber(p.y, 12) + ", " + FormatNumber(p.z, 12) +
+                  "); expected finite coordinates");
     }
   }
 }
@@ -49,7 +44,8 @@ void WriteXyz(const std::filesystem::path& path, const std::vector<PointRecord>&
                            ColorTo8(p.b));
       }
       if (n < 0 || n >= static_cast<int>(sizeof line)) {
-        throw Error(path.string() + ": point (" + Num(p.x) + ", " + Num(p.y) + ", " + Num(p.z) +
+        throw Error(path.string() + ": point (" + FormatNumber(p.x, 12) + ", " +
+                    FormatNumber(p.y, 12) + ", " + FormatNumber(p.z, 12) +
                     ") does not fit an XYZ line");
       }
       line[n] = '\n';

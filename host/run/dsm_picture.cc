@@ -19,6 +19,7 @@
 
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs {
 namespace {
@@ -43,13 +44,6 @@ struct DatasetCloser {
   void operator()(GDALDatasetH ds) const { GDALClose(ds); }
 };
 using Dataset = std::unique_ptr<void, DatasetCloser>;
-
-std::string Num(double v, int precision = 17) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
 
 // The ramp's RGB at share t of the height range, as GDAL interpolates it.
 cv::Vec3b Ramp(double t) {
@@ -117,7 +111,7 @@ std::vector<uint8_t> ShadedRelief(const GeoRaster& dsm, double lo, double hi,
   const Dataset src = MemDsm(dsm, file);
   // GDAL reads the colour table from a file; an in-memory one will do.
   const std::string table =
-      "/vsimem/sapmvs_relief_" + Num(reinterpret_cast<uintptr_t>(&dsm)) + ".txt";
+      "/vsimem/sapmvs_relief_" + FormatNumber(reinterpret_cast<uintptr_t>(&dsm), 17) + ".txt";
   std::ostringstream text;
   text.precision(17);
   text << "nv 0 0 0 0\n";
@@ -185,7 +179,7 @@ void DrawLegend(cv::Mat* img, int x0, double lo, double hi, double pixel_size,
   for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * step; v += step) {
     const int y = top + static_cast<int>(std::lround((hi - v) / (hi - lo) * (bar_h - 1)));
     cv::line(*img, {left + bar_w, y}, {left + bar_w + 5, y}, cv::Scalar(0, 0, 0));
-    Text(img, Num(std::abs(v) < 1e-9 * step ? 0 : v, 6), left + bar_w + 9, y + 5);
+    Text(img, FormatNumber(std::abs(v) < 1e-9 * step ? 0 : v, 6), left + bar_w + 9, y + 5);
   }
   int y = top + bar_h + 24;
   cv::rectangle(*img, {left, y - 10}, {left + bar_w, y}, cv::Scalar(kNodataGrey));
@@ -197,7 +191,7 @@ void DrawLegend(cv::Mat* img, int x0, double lo, double hi, double pixel_size,
     y += 40;
     cv::rectangle(*img, {left, y - 6}, {left + px / 2, y}, cv::Scalar(0, 0, 0), cv::FILLED);
     cv::rectangle(*img, {left, y - 6}, {left + px, y}, cv::Scalar(0, 0, 0));
-    Text(img, Num(length, 6) + " " + (unit.empty() ? "CRS units" : unit), left, y + 20);
+    Text(img, FormatNumber(length, 6) + " " + (unit.empty() ? "CRS units" : unit), left, y + 20);
   }
   Text(img, "north up", left, y + 44);
 }

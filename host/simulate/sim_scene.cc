@@ -9,6 +9,7 @@
 #include <random>
 
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/number_text.h"
 
 namespace sapmvs::sim {
 
@@ -27,7 +28,6 @@ uint8_t LasClass(SurfaceClass k) {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kStorey = 3.0;  // m
 
