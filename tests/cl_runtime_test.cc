@@ -287,6 +287,26 @@ TEST_F(ClRuntimeTest, BrokenKernelThrowsProgramBuildErrorWithLog) {
   EXPECT_EQ(context().NumCachedPrograms(), before);
 }
 
+TEST_F(ClRuntimeTest, DeviceBytesCountLiveBuffersAndTheirPeak) {
+  const double live = DeviceBytesInUse();
+  ResetPeakDeviceBytes();
+  EXPECT_EQ(PeakDeviceBytes(), live);
+  {
+    ClBuffer a(context(), 1000);
+    ClBuffer b(context(), 24);
+    EXPECT_EQ(DeviceBytesInUse(), live + 1024);
+    // A move carries the count; the moved-from buffer holds none.
+    ClBuffer c = std::move(b);
+    EXPECT_EQ(DeviceBytesInUse(), live + 1024);
+    a = ClBuffer(context(), 10);
+    EXPECT_EQ(DeviceBytesInUse(), live + 34);
+  }
+  EXPECT_EQ(DeviceBytesInUse(), live);
+  EXPECT_EQ(PeakDeviceBytes(), live + 1024 + 10);  // a's new buffer before the old one went
+  ResetPeakDeviceBytes();
+  EXPECT_EQ(PeakDeviceBytes(), live);
+}
+
 TEST_F(ClRuntimeTest, EnqueueRoundsGlobalUpToWorkGroupMultiple) {
   ClKernel kernel =
       context().ProgramFromSource("iota_test", kIotaSource, {{"SCALE", "3"}}).Kernel("iota");

@@ -403,7 +403,8 @@ TEST(GroupingMemory, TinyBudgetIsAClearError) {
   } catch (const Error& e) {
     const std::string what = e.what();
     EXPECT_NE(what.find("memory budget 1 MiB is too small"), std::string::npos) << what;
-    EXPECT_NE(what.find("2 images"), std::string::npos) << what;
+    // min_image_num (3) images: the fewest a group can match.
+    EXPECT_NE(what.find("3 images"), std::string::npos) << what;
     EXPECT_NE(what.find("level 1"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
@@ -421,6 +422,49 @@ TEST(GroupingMemory, BudgetShortensTheRunsOfAStrip) {
   EXPECT_EQ(Sizes(plan),
             (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
   for (const ImageGroup& g : plan.groups) EXPECT_LE(g.memory.Total(), o.memory_budget);
+}
+
+TEST(GroupingMemory, BudgetBelowTheFewestImagesAGroupCanMatchIsAnError) {
+  const SimBlock s = MakeSimBlock("campus");
+  MatcherOptions m;
+  m.min_image_num = 4;
+  GroupingOptions o;
+  // Three images fit, four do not: groups of three would match nothing.
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, m).Total() + 1;
+  try {
+    PlanGroups(s.block, o, m);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("4 images, the fewest a group can match (min_image_num 4)"),
+              std::string::npos)
+        << what;
+  }
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, m).Total() + 1;
+  for (const ImageGroup& g : PlanGroups(s.block, o, m).groups) EXPECT_GE(g.images.size(), 4u);
+}
+
+TEST(GroupingMemory, TheProcessCountsInEveryGroupAndInTheBudget) {
+  const SimBlock s = MakeSimBlock("campus");
+  const double process = 300.0 * (1 << 20);
+  GroupingOptions o;
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + process + 1;
+  const GroupingPlan with = PlanGroups(s.block, o, MatcherOptions{}, nullptr, process);
+  EXPECT_EQ(with.process_bytes, process);
+  // The same runs as BudgetShortensTheRunsOfAStrip, whose budget is this one
+  // less the process.
+  EXPECT_EQ(Sizes(with),
+            (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
+  for (const ImageGroup& g : with.groups) {
+    EXPECT_EQ(g.memory.process_bytes, process);
+    EXPECT_DOUBLE_EQ(g.memory.Total(), EstimateGroupMemory(s.block, g.images, 1).Total() + process);
+    EXPECT_LE(g.memory.Total(), o.memory_budget);
+  }
+  // Without the process in the budget the groups would not have fitted.
+  GroupingOptions tight = o;
+  tight.memory_budget = o.memory_budget - process;
+  EXPECT_THROW(PlanGroups(s.block, tight, MatcherOptions{}, nullptr, 2 * process), Error);
+  EXPECT_THROW(PlanGroups(s.block, o, MatcherOptions{}, nullptr, -1), Error);
 }
 
 TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {

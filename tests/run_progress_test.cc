@@ -54,6 +54,11 @@ TEST(RunProgress, LineShowsGroupStageAndEta) {
       << c.Text();
   // 6 of 10 images left at the first group's pace.
   EXPECT_GE(p.EtaSeconds(), 0);
+  // The group's measured peak beside the plan's estimate.
+  p.StartGroup(1, 3, 2);
+  p.EndGroup(7, 300.0 * (1 << 20), 256.0 * (1 << 20));
+  EXPECT_NE(c.Text().find("group 2/3: 2 images, 7 points, 0:0"), std::string::npos) << c.Text();
+  EXPECT_NE(c.Text().find(", peak 300 MiB (estimate 256 MiB)\n"), std::string::npos) << c.Text();
   p.StartGroup(2, 3, 6);
   line = p.Line();
   EXPECT_EQ(line.rfind("group 3/3 (6 images)  load", 0), 0u) << line;

@@ -13,10 +13,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
+#include "device/make_patch_kernels.h"
+#include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/block_reader.h"
 #include "sapmvs/plan/grouping.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/memory_use.h"
 #include "util/option_flags.h"
 
 namespace sapmvs::cli {
@@ -52,7 +55,18 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
     // A JSON path in a missing folder fails here, before the block is read.
     if (!args->json.empty()) AtomicFile check(args->json);
     const Block block = ReadBlock(args->block, read);
-    const GroupingPlan plan = PlanGroups(block, args->grouping, args->matcher);
+    const BlockGeometry geometry = EstimateBlockGeometry(block);
+    // The estimates count what the matching process holds before its first
+    // group; `run` holds the device's runtime too, so it is loaded here as
+    // `run` would load it (SAPMVS_DEVICE or the default device), when there is one.
+    std::unique_ptr<PatchKernels> kernels;
+    try {
+      kernels = MakePatchKernels(PatchKernelsOptions{});
+    } catch (const NoDeviceError&) {
+    }
+    ReleaseFreeMemory();
+    const GroupingPlan plan =
+        PlanGroups(block, args->grouping, args->matcher, &geometry, CurrentRssBytes());
     PrintPlan(block, plan, std::cout);
     if (!args->json.empty()) {
       WriteTextAtomically(args->json, PlanToJson(block, plan).dump(2) + "\n");

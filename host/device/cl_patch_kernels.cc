@@ -45,6 +45,9 @@ class ClPatchKernels : public PatchKernels {
 
   const KernelDevice& device() const override { return device_; }
 
+  double PeakDeviceBytes() const override { return sapmvs::PeakDeviceBytes(); }
+  void ResetPeakDeviceBytes() override { sapmvs::ResetPeakDeviceBytes(); }
+
   void SetGroup(const NccGroup& group) override {
     ClearGroup();  // first, so that the old group's buffers are freed before the upload
     group_ = std::make_shared<const NccDeviceGroup>(UploadNccGroup(context_, group));

@@ -3,6 +3,7 @@
 #include <CL/cl_ext.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <charconv>
 #include <cstdio>
@@ -270,6 +271,33 @@ uint64_t ClEvent::DeviceTimeNs() const {
   return end >= start ? end - start : 0;
 }
 
+namespace {
+std::atomic<size_t> device_bytes_in_use{0};
+std::atomic<size_t> device_bytes_peak{0};
+}  // namespace
+
+namespace internal {
+DeviceBytesCount::DeviceBytesCount(size_t bytes) : bytes_(bytes) {
+  const size_t now = device_bytes_in_use += bytes;
+  size_t peak = device_bytes_peak.load();
+  while (now > peak && !device_bytes_peak.compare_exchange_weak(peak, now)) {
+  }
+}
+DeviceBytesCount::~DeviceBytesCount() { device_bytes_in_use -= bytes_; }
+DeviceBytesCount& DeviceBytesCount::operator=(DeviceBytesCount&& o) noexcept {
+  if (this != &o) {
+    device_bytes_in_use -= bytes_;
+    bytes_ = o.bytes_;
+    o.bytes_ = 0;
+  }
+  return *this;
+}
+}  // namespace internal
+
+double DeviceBytesInUse() { return static_cast<double>(device_bytes_in_use.load()); }
+double PeakDeviceBytes() { return static_cast<double>(device_bytes_peak.load()); }
+void ResetPeakDeviceBytes() { device_bytes_peak = device_bytes_in_use.load(); }
+
 ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags) : size_(bytes) {
   if (bytes == 0) throw Error("cannot create an empty OpenCL buffer (0 bytes)");
   if (bytes > context.device().max_alloc_bytes) {
@@ -285,6 +313,7 @@ ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags) :
   }
   CL_CHECK(clRetainCommandQueue(context.queue()));
   queue_ = internal::ClHandle<cl_command_queue>(context.queue());
+  count_ = internal::DeviceBytesCount(bytes);
 }
 
 void ClBuffer::CheckRange(const char* what, size_t bytes, size_t offset) const {

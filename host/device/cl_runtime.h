@@ -184,6 +184,31 @@ class ClEvent {
 
 // A device buffer. Write/Read are blocking and go through the context's queue
 // (the buffer keeps its own reference to it).
+namespace internal {
+// Counts a buffer's bytes as device memory in use while it lives
+// (DeviceBytesInUse); moves with the buffer.
+class DeviceBytesCount {
+ public:
+  DeviceBytesCount() = default;
+  explicit DeviceBytesCount(size_t bytes);
+  ~DeviceBytesCount();
+  DeviceBytesCount(DeviceBytesCount&& o) noexcept : bytes_(o.bytes_) { o.bytes_ = 0; }
+  DeviceBytesCount& operator=(DeviceBytesCount&& o) noexcept;
+  DeviceBytesCount(const DeviceBytesCount&) = delete;
+  DeviceBytesCount& operator=(const DeviceBytesCount&) = delete;
+
+ private:
+  size_t bytes_ = 0;
+};
+}  // namespace internal
+
+// Bytes of the OpenCL buffers alive in this process, now and at their peak
+// since ResetPeakDeviceBytes: what the device holds for us, which on a CPU
+// device is also part of the process's RSS.
+double DeviceBytesInUse();
+double PeakDeviceBytes();
+void ResetPeakDeviceBytes();
+
 class ClBuffer {
  public:
   ClBuffer() = default;
@@ -218,6 +243,7 @@ class ClBuffer {
   internal::ClHandle<cl_mem> mem_;
   internal::ClHandle<cl_command_queue> queue_;
   size_t size_ = 0;
+  internal::DeviceBytesCount count_;
 };
 
 // A `__local` kernel argument of `bytes` bytes, for ClKernel::SetArgs.

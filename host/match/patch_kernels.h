@@ -49,6 +49,12 @@ class PatchKernels {
   // Lets go of the group (and the device memory that holds it).
   virtual void ClearGroup() = 0;
 
+  // Device memory this backend holds, bytes, at its peak since
+  // ResetPeakDeviceBytes (the group's images and the largest batch): what a
+  // GPU must have free. 0 for the reference, whose memory is the host's.
+  virtual double PeakDeviceBytes() const { return 0; }
+  virtual void ResetPeakDeviceBytes() {}
+
   // scores[i] = NCC of pairs[i] at options.patch_size with options'
   // sample weights, NaN where undefined. Throws Error for bad options or a
   // bad batch (ValidateNccBatch) before any work. `seconds` (may be null)

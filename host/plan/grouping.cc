@@ -84,30 +84,40 @@ std::string GroupNames(const Block& block, const std::vector<int>& ids) {
   return ids.size() > 4 ? s + ", ..." : s;
 }
 
-// Throws when the smallest useful group, the two largest images, does not
-// fit: every other pair then fits too, as the estimate grows with pixels.
-void CheckTwoImagesFit(const Block& block, const GroupingOptions& o, const MatcherOptions& m) {
+// Throws when the smallest group that can be matched does not fit: the
+// min_image_num (at least 2) largest images, as a point needs that many
+// views. Every other group of that size then fits too, as the estimate grows
+// with pixels; a budget that only fit smaller groups would match nothing.
+void CheckSmallestGroupFits(const Block& block, const GroupingOptions& o, const MatcherOptions& m,
+                            double process_bytes) {
   std::vector<int> ids(block.images.size());
   std::iota(ids.begin(), ids.end(), 0);
-  std::partial_sort(ids.begin(), ids.begin() + 2, ids.end(), [&](int a, int b) {
+  const size_t k = std::min(ids.size(), static_cast<size_t>(std::max(2, m.min_image_num)));
+  std::partial_sort(ids.begin(), ids.begin() + k, ids.end(), [&](int a, int b) {
     const Camera &ca = block.images[a].camera, &cb = block.images[b].camera;
     return static_cast<double>(ca.width()) * ca.height() >
            static_cast<double>(cb.width()) * cb.height();
   });
-  ids.resize(2);
-  const GroupMemory mem = EstimateGroupMemory(block, ids, m);
+  ids.resize(k);
+  GroupMemory mem = EstimateGroupMemory(block, ids, m);
+  mem.process_bytes = process_bytes;
   if (mem.Total() > o.memory_budget) {
-    throw Error("memory budget " + FormatBytes(o.memory_budget) +
-                " is too small: a group of 2 images (" + GroupNames(block, ids) + ") needs " +
-                FormatBytes(mem.Total()) + " at level " + std::to_string(m.level) + " (device " +
-                FormatBytes(mem.device_bytes) + " + host " + FormatBytes(mem.host_bytes) +
-                "); raise the budget or match at a coarser level");
+    throw Error(
+        "memory budget " + FormatBytes(o.memory_budget) + " is too small: " + std::to_string(k) +
+        " images, the fewest a group can match (min_image_num " + std::to_string(m.min_image_num) +
+        "), need " + FormatBytes(mem.Total()) + " at level " + std::to_string(m.level) + " (" +
+        GroupNames(block, ids) + ": device " + FormatBytes(mem.device_bytes) + " + host " +
+        FormatBytes(mem.host_bytes) +
+        (process_bytes > 0 ? " + the process before matching " + FormatBytes(process_bytes)
+                           : std::string()) +
+        "); raise the budget or match at a coarser level");
   }
 }
 
 // The plan's options and matcher say what a group may use.
 bool Fits(const Block& block, const std::vector<int>& ids, const GroupingPlan& plan) {
-  return EstimateGroupMemory(block, ids, plan.matcher).Total() <= plan.options.memory_budget;
+  return EstimateGroupMemory(block, ids, plan.matcher).Total() + plan.process_bytes <=
+         plan.options.memory_budget;
 }
 
 Eigen::Vector2d MeanCenter(const std::vector<Footprint>& fp, const std::vector<int>& ids) {
@@ -447,7 +457,8 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
 }
 
 GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
-                        const MatcherOptions& matcher, const BlockGeometry* known_geometry) {
+                        const MatcherOptions& matcher, const BlockGeometry* known_geometry,
+                        double process_bytes) {
   if (const std::string problem = options.Problem(); !problem.empty())
     throw Error("grouping options: expected " + problem);
   if (const std::string problem = matcher.Problem(); !problem.empty())
@@ -456,8 +467,12 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     throw Error("grouping needs at least 2 images, " + block.source.string() + " has " +
                 std::to_string(block.images.size()));
   }
-  CheckTwoImagesFit(block, options, matcher);
+  if (!(std::isfinite(process_bytes) && process_bytes >= 0))
+    throw Error("grouping: expected the process's memory >= 0 (process_bytes = " +
+                std::to_string(process_bytes) + ")");
+  CheckSmallestGroupFits(block, options, matcher, process_bytes);
   GroupingPlan plan;
+  plan.process_bytes = process_bytes;
   plan.strategy = options.strategy;
   plan.options = options;
   plan.matcher = matcher;
@@ -477,6 +492,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   all.images.resize(block.images.size());
   std::iota(all.images.begin(), all.images.end(), 0);
   all.memory = EstimateGroupMemory(block, all.images, matcher);
+  all.memory.process_bytes = process_bytes;
   if (static_cast<int>(all.images.size()) <= options.max_images &&
       all.memory.Total() <= options.memory_budget) {
     for (const int i : all.images) all.center += fp[i].center;
@@ -489,6 +505,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   }
   for (ImageGroup& g : plan.groups) {
     g.memory = EstimateGroupMemory(block, g.images, matcher);
+    g.memory.process_bytes = process_bytes;
     g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num);
   }
   return plan;

@@ -91,8 +91,9 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
     for (const int i : plan.ungrouped) out << " " << (i + 1) << " " << block.images[i].name;
     out << "\n";
   }
-  out << "largest     " << FormatBytes(largest) << " (device + host) of "
-      << FormatBytes(o.memory_budget) << "; centres in the local frame, origin "
+  out << "largest     " << FormatBytes(largest) << " (device + host";
+  if (plan.process_bytes > 0) out << " + the process's " << FormatBytes(plan.process_bytes);
+  out << ") of " << FormatBytes(o.memory_budget) << "; centres in the local frame, origin "
       << Fixed(block.origin.x(), 3) << " " << Fixed(block.origin.y(), 3) << "\n";
 }
 
@@ -118,13 +119,15 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
   for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
   j["groups"] = json::array();
   for (const ImageGroup& g : plan.groups) {
-    json jg = {
-        {"indices", g.images},
-        {"names", names(g.images)},
-        {"strip", g.strip < 0 ? json(nullptr) : json(g.strip)},
-        {"center", {g.center.x(), g.center.y()}},
-        {"memory", {{"device_bytes", g.memory.device_bytes}, {"host_bytes", g.memory.host_bytes}}},
-        {"short_of_views", names(g.short_of_views)}};
+    json jg = {{"indices", g.images},
+               {"names", names(g.images)},
+               {"strip", g.strip < 0 ? json(nullptr) : json(g.strip)},
+               {"center", {g.center.x(), g.center.y()}},
+               {"memory",
+                {{"device_bytes", g.memory.device_bytes},
+                 {"host_bytes", g.memory.host_bytes},
+                 {"process_bytes", g.memory.process_bytes}}},
+               {"short_of_views", names(g.short_of_views)}};
     if (plan.strategy == GroupingStrategy::kFootprint)
       jg["tile"] = {{"min", {g.tile_min.x(), g.tile_min.y()}},
                     {"max", {g.tile_max.x(), g.tile_max.y()}}};

@@ -27,6 +27,7 @@
 #include "sapmvs/run/cloud_las.h"
 #include "sapmvs/run/cloud_merge.h"
 #include "sapmvs/run/dsm_picture.h"
+#include "sapmvs/util/byte_size.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/log.h"
 #include "sapmvs/util/memory_use.h"
@@ -79,6 +80,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
     } else {
       it->second.wall += t.wall;
       it->second.device += t.device;
+      it->second.peak_rss_bytes = std::max(it->second.peak_rss_bytes, t.peak_rss_bytes);
     }
   }
   for (const auto& [name, k] : s.kernels) {
@@ -125,11 +127,8 @@ RunReport RunDense(const RunOptions& options) {
   if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
     throw Error(reason);
   }
-  const GroupingPlan plan = PlanGroups(block, options.grouping, options.matcher, &geometry);
-  report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
-  for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
-  end_stage("plan");
-
+  // The device before the plan, which counts its runtime's memory; after the
+  // geometry, whose DEM would otherwise add to the runtime's peak.
   PatchKernelsOptions kernel_options;
   kernel_options.device = options.device;
   kernel_options.profile = options.profile;
@@ -138,6 +137,15 @@ RunReport RunDense(const RunOptions& options) {
   report.device = device.description;
   report.device_info = {device.name, device.vendor, device.platform, device.type};
   LogDetail("device: " + report.device);
+
+  // What the process holds before any group, once what planning freed is
+  // handed back: every group's estimate adds it.
+  ReleaseFreeMemory();
+  const GroupingPlan plan =
+      PlanGroups(block, options.grouping, options.matcher, &geometry, CurrentRssBytes());
+  report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
+  for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
+  end_stage("plan");
 
   const OutputFolder folder(options.out, "run", {"groups"});
   if (options.restart) RemoveRunOutputs(options.out);
@@ -160,11 +168,13 @@ RunReport RunDense(const RunOptions& options) {
   for (int g = 0; g < n; ++g) {
     GroupRun run;
     run.index = g;
+    run.memory_estimate_bytes = plan.groups[g].memory.Total();
     for (const int i : plan.groups[g].images) run.images.push_back(block.images[i].name);
     if (checkpoints.Done(g)) {
       const GroupCheckpoint c = checkpoints.Read(g);
       run.points = c.points;
       run.seconds = c.seconds;
+      run.memory = c.memory;
       run.resumed = true;
       report.groups.push_back(run);
       continue;
@@ -176,19 +186,26 @@ RunReport RunDense(const RunOptions& options) {
     }
     progress.StartGroup(g, n, static_cast<long>(plan.groups[g].images.size()));
     const auto t0 = std::chrono::steady_clock::now();
+    ReleaseFreeMemory();  // what the groups before freed
+    run.memory.rss_before_bytes = CurrentRssBytes();
+    run.memory.peak_of_group = ResetPeakRss();
+    kernels->ResetPeakDeviceBytes();
     MatchResult result =
         MatchGroup(block, plan.groups[g].images, options.matcher, *kernels, &geometry,
                    [&](const MatchProgressEvent& e) { progress.Update(e); });
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
-    progress.EndGroup(run.points);
+    run.memory.peak_rss_bytes = PeakRssBytes();
+    run.memory.peak_device_bytes = kernels->PeakDeviceBytes();
+    progress.EndGroup(run.points, run.memory.peak_rss_bytes, plan.groups[g].memory.Total());
     AddStats(result.stats, &report.stats);
     for (const auto& [name, t] : result.stats.stages) {
       LogDetail("group " + std::to_string(g + 1) + "/" + std::to_string(n) + ": " + name + " " +
                 Seconds(t.wall) +
                 (options.profile ? ", " + Seconds(t.device) + " in kernels" : ""));
     }
-    checkpoints.Write(g, result.cloud, run.seconds, result.stats, options.profile);
+    checkpoints.Write(g, result.cloud, {run.points, run.seconds, run.memory}, result.stats,
+                      options.profile);
     ++matched_now;
     report.groups.push_back(run);
   }
@@ -196,7 +213,7 @@ RunReport RunDense(const RunOptions& options) {
   end_stage("match");
   if (stopped) {
     report.total_seconds = Since(start);
-    report.peak_rss_bytes = PeakRssBytes();
+    report.peak_rss_bytes = ProcessPeakRssBytes();
     return report;  // resumable
   }
 
@@ -243,7 +260,7 @@ RunReport RunDense(const RunOptions& options) {
   end_stage("write");
   report.finished = true;
   report.total_seconds = Since(start);
-  report.peak_rss_bytes = PeakRssBytes();
+  report.peak_rss_bytes = ProcessPeakRssBytes();
   report.end_time = std::chrono::system_clock::now();
   WriteRunReport(options, report, block, plan);
   return report;
@@ -265,9 +282,12 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
       out << std::setw(9) << g.points << " points  (checkpoint)";
     } else if (g.seconds > 0 || g.points > 0) {
       out << std::setw(9) << g.points << " points  " << FormatHms(g.seconds);
-    } else {
-      out << "          not run yet";
     }
+    if (g.memory.peak_rss_bytes > 0) {
+      out << "  peak " << FormatBytes(g.memory.peak_rss_bytes) << " (estimate "
+          << FormatBytes(g.memory_estimate_bytes) << ")";
+    }
+    if (!g.resumed && g.seconds <= 0 && g.points <= 0) out << "          not run yet";
     out << "\n";
   }
   if (s.waves > 0) {

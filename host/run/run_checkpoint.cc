@@ -117,17 +117,28 @@ GroupCheckpoint RunCheckpoints::Read(int group) const {
   GroupCheckpoint c;
   c.points = j.value("points", 0L);
   c.seconds = j.value("seconds", 0.0);
+  // Checkpoints from before the measurement have none: zeros, as not measured.
+  if (const auto m = j.find("memory"); m != j.end() && m->is_object()) {
+    c.memory.rss_before_bytes = m->value("rss_before_bytes", 0.0);
+    c.memory.peak_rss_bytes = m->value("peak_rss_bytes", 0.0);
+    c.memory.peak_of_group = m->value("peak_of_group", false);
+    c.memory.peak_device_bytes = m->value("peak_device_bytes", 0.0);
+  }
   return c;
 }
 
-void RunCheckpoints::Write(int group, const PointCloud& cloud, double seconds,
+void RunCheckpoints::Write(int group, const PointCloud& cloud, const GroupCheckpoint& done,
                            const MatchStats& stats, bool device_times) {
   WritePly(CloudPath(group), cloud);
   nlohmann::json j = MatchStatsJson(stats, device_times);
   j["status"] = "done";
   j["group"] = group + 1;
   j["points"] = static_cast<long>(cloud.points.size());
-  j["seconds"] = seconds;
+  j["seconds"] = done.seconds;
+  j["memory"] = {{"rss_before_bytes", done.memory.rss_before_bytes},
+                 {"peak_rss_bytes", done.memory.peak_rss_bytes},
+                 {"peak_of_group", done.memory.peak_of_group},
+                 {"peak_device_bytes", done.memory.peak_device_bytes}};
   WriteJsonFile(StatusPath(group), j);
 }
 

@@ -12,12 +12,14 @@
 #include "sapmvs/match/match_stats.h"
 #include "sapmvs/match/matcher_options.h"
 #include "sapmvs/plan/grouping.h"
+#include "sapmvs/run/run_result.h"
 
 namespace sapmvs {
 
 struct GroupCheckpoint {
   long points = 0;
   double seconds = 0;
+  GroupMemoryUse memory;
 };
 
 // Removes what `sapmvs run` writes into `out` (cloud.ply, cloud.las, dsm.tif
@@ -38,8 +40,8 @@ class RunCheckpoints {
   bool Done(int group) const;
   GroupCheckpoint Read(int group) const;
   // `device_times`: the stats hold measured kernel times (--profile).
-  void Write(int group, const PointCloud& cloud, double seconds, const MatchStats& stats,
-             bool device_times);
+  void Write(int group, const PointCloud& cloud, const GroupCheckpoint& done,
+             const MatchStats& stats, bool device_times);
   std::filesystem::path CloudPath(int group) const;
   std::filesystem::path StatusPath(int group) const;
 

@@ -134,7 +134,14 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
       const Eigen::Vector2d c = plan.groups[g].center + block.origin.head<2>();
       e["center"] = {c.x(), c.y()};
       e["memory_estimate_bytes"] = {{"device", plan.groups[g].memory.device_bytes},
-                                    {"host", plan.groups[g].memory.host_bytes}};
+                                    {"host", plan.groups[g].memory.host_bytes},
+                                    {"total", plan.groups[g].memory.Total()}};
+    }
+    if (r.memory.peak_rss_bytes > 0) {
+      e["memory_measured_bytes"] = {{"rss_before", r.memory.rss_before_bytes},
+                                    {"peak_rss", r.memory.peak_rss_bytes},
+                                    {"peak_is_group_own", r.memory.peak_of_group},
+                                    {"device_peak", r.memory.peak_device_bytes}};
     }
     if (g < report.merge.kept_by_group.size()) {
       e["kept_after_merge"] = report.merge.kept_by_group[g];

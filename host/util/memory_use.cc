@@ -1,13 +1,62 @@
 #include "sapmvs/util/memory_use.h"
 
 #include <sys/resource.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+#include <algorithm>
+#include <atomic>
+#include <fstream>
+#include <string>
 
 namespace sapmvs {
 
+namespace {
+
+// A "Name:   123 kB" line of /proc/self/status, in bytes; 0 when absent.
+double ProcStatusBytes(const std::string& name) {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.compare(0, name.size(), name) == 0 && line.size() > name.size() &&
+        line[name.size()] == ':') {
+      return 1024.0 * std::stod(line.substr(name.size() + 1));
+    }
+  }
+  return 0;
+}
+
+// The process's peak before the last reset (ResetPeakRss).
+std::atomic<double> peak_before_reset{0};
+
+}  // namespace
+
 double PeakRssBytes() {
+  // VmHWM follows ResetPeakRss; getrusage's ru_maxrss does not.
+  const double hwm = ProcStatusBytes("VmHWM");
+  if (hwm > 0) return hwm;
   rusage u{};
   getrusage(RUSAGE_SELF, &u);
   return 1024.0 * static_cast<double>(u.ru_maxrss);  // Linux reports kilobytes
+}
+
+double CurrentRssBytes() { return ProcStatusBytes("VmRSS"); }
+
+double ProcessPeakRssBytes() { return std::max(peak_before_reset.load(), PeakRssBytes()); }
+
+bool ResetPeakRss() {
+  peak_before_reset = ProcessPeakRssBytes();
+  std::ofstream f("/proc/self/clear_refs");
+  if (!f) return false;
+  f << "5" << std::flush;  // 5: reset the peak RSS (proc(5))
+  return static_cast<bool>(f);
+}
+
+void ReleaseFreeMemory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
 }
 
 }  // namespace sapmvs

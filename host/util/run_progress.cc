@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "sapmvs/util/byte_size.h"
 
 namespace sapmvs {
 
@@ -74,15 +77,19 @@ void RunProgress::Update(const MatchProgressEvent& e) {
   std::fflush(out_);
 }
 
-void RunProgress::EndGroup(long points) {
+void RunProgress::EndGroup(long points, double peak_rss_bytes, double estimate_bytes) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - group_start_).count();
   matched_seconds_ += seconds;
   images_done_ += group_images_;
   if (!enabled_) return;
-  const std::string line = "group " + std::to_string(index_ + 1) + "/" +
-                           std::to_string(group_count_) + ": " + std::to_string(group_images_) +
-                           " images, " + std::to_string(points) + " points, " + Clock(seconds);
+  std::string line = "group " + std::to_string(index_ + 1) + "/" + std::to_string(group_count_) +
+                     ": " + std::to_string(group_images_) + " images, " + std::to_string(points) +
+                     " points, " + Clock(seconds);
+  if (peak_rss_bytes > 0 && estimate_bytes > 0) {
+    line +=
+        ", peak " + FormatBytes(peak_rss_bytes) + " (estimate " + FormatBytes(estimate_bytes) + ")";
+  }
   std::fprintf(out_, "\r%s%*s\n", line.c_str(),
                static_cast<int>(drawn_ > line.size() ? drawn_ - line.size() : 0), "");
   drawn_ = 0;

@@ -20,7 +20,9 @@ class RunProgress {
 
   void StartGroup(int index, int group_count, long group_images);
   void Update(const MatchProgressEvent& e);
-  void EndGroup(long points);
+  // The group's line; with its measured peak RSS and the plan's estimate
+  // (bytes) when both are > 0.
+  void EndGroup(long points, double peak_rss_bytes = 0, double estimate_bytes = 0);
   // Clears the status line (before the run's summary is printed).
   void Finish();
 

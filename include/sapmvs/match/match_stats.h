@@ -13,7 +13,10 @@ namespace sapmvs {
 struct StageTime {
   double wall = 0;
   double device = 0;
-  double peak_rss_bytes = 0;  // the process's peak so far, at the stage's end
+  // Peak RSS at the stage's end: the group's so far where the run reset the
+  // peak at its start (ResetPeakRss), else the process's; over a run's
+  // groups, the highest.
+  double peak_rss_bytes = 0;
 };
 
 struct KernelTime {

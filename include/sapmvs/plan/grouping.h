@@ -28,7 +28,11 @@ struct BlockGeometry;
 struct GroupMemory {
   double device_bytes = 0;
   double host_bytes = 0;
-  double Total() const { return device_bytes + host_bytes; }
+  // The process before the group: the program and its libraries, the OpenCL
+  // runtime, the block (GroupingPlan::process_bytes). Matching adds the
+  // other two terms to it, so their sum is what the process peaks at.
+  double process_bytes = 0;
+  double Total() const { return device_bytes + host_bytes + process_bytes; }
 };
 
 // Memory to match `images` of `block` at `level`, in bytes. With, for image
@@ -91,6 +95,9 @@ struct GroupingPlan {
   // The whole block is one group: it has at most max_images images and fits
   // memory_budget, and splitting it would only lose views.
   bool single_group = false;
+  // What the process held when it planned (PlanGroups' process_bytes), part
+  // of every group's estimate and so of what memory_budget bounds.
+  double process_bytes = 0;
 };
 
 // Plans the groups of `block`. A block of at most max_images images whose
@@ -101,7 +108,8 @@ struct GroupingPlan {
 // 2), so no group has a single image; a block with no strip of 2 or more images (terrestrial,
 // convergent) is cut in block order as one strip, its groups with strip -1. Footprint strategy:
 // images without a surface estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error
-// for bad options, a block of fewer than 2 images, and when 2 images do not fit memory_budget.
+// for bad options, a block of fewer than 2 images, and when min_image_num images (at least 2)
+// do not fit memory_budget.
 // `matcher`: the options the groups will be matched with. Its level, cell
 // size and wave size set the memory estimate; a strip run shorter than its
 // min_image_num takes the strip images before it, and images of a group that
@@ -109,8 +117,12 @@ struct GroupingPlan {
 // (short_of_views), since they cannot be matched there.
 // `geometry`: EstimateBlockGeometry(block) when the caller has it (it reads
 // the block's DEM), else nullptr and it is estimated here.
+// `process_bytes`: what the process that will match holds before any group
+// (run: its RSS once the block is read and the device set up), added to
+// every group's estimate; 0 = the groups' own memory only.
 GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
-                        const MatcherOptions& matcher, const BlockGeometry* geometry = nullptr);
+                        const MatcherOptions& matcher, const BlockGeometry* geometry = nullptr,
+                        double process_bytes = 0);
 
 // Like the paper's Table 3: group, image numbers (1-based), image names,
 // number of images, and the memory estimate of each group.

@@ -13,12 +13,30 @@
 
 namespace sapmvs {
 
+// Memory that matching one group took, measured, to set beside the plan's
+// estimate (GroupMemory).
+struct GroupMemoryUse {
+  // The process's RSS before the group: libraries, the block, the device's
+  // context and what earlier groups left to the allocator.
+  double rss_before_bytes = 0;
+  // The process's peak RSS while matching the group, and whether it is the
+  // group's own: false where the system cannot reset the peak
+  // (ResetPeakRss), so that it is the process's peak so far.
+  double peak_rss_bytes = 0;
+  bool peak_of_group = false;
+  // The device's buffers at their peak (PatchKernels::PeakDeviceBytes); on a
+  // CPU device they are also part of the RSS.
+  double peak_device_bytes = 0;
+};
+
 struct GroupRun {
   int index = 0;  // 0-based
   std::vector<std::string> images;
   long points = 0;
   double seconds = 0;
-  bool resumed = false;  // read from a checkpoint of an earlier call
+  bool resumed = false;              // read from a checkpoint of an earlier call
+  double memory_estimate_bytes = 0;  // the plan's (GroupMemory::Total)
+  GroupMemoryUse memory;
 };
 
 // The device a run used (an OpenCL device or the CPU reference), as
