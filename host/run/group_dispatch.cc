@@ -73,14 +73,20 @@ void GroupDispatch::Start() {
 
 void GroupDispatch::Open(const fs::path& dir) {
   dir_ = dir;
-  if (session_.size() == 1 || !merges()) return;
-  RemoveClaims(dir_);  // of earlier runs: rank 0 alone, before the others start
-  run_id_ = session_.Broadcast(MakeRunId());
+  if (session_.size() == 1) return;
+  if (merges()) {
+    RemoveClaims(dir_);  // of earlier runs: rank 0 alone, before the others start
+    run_id_ = session_.Broadcast(MakeRunId());
+  }
+  // No group is matched until every rank has its block, plan and device: a
+  // rank that cannot start stops the job before any work.
+  session_.Barrier();
 }
 
 bool GroupDispatch::Claim(int group) {
   if (session_.size() > 1) {
-    const std::string text = "run " + run_id_ + " rank " + std::to_string(session_.rank()) + "\n";
+    const std::string text = "run " + run_id_ + " rank " + std::to_string(session_.rank()) +
+                             " pid " + std::to_string(::getpid()) + "\n";
     if (!CreateClaim(ClaimPath(dir_, group), text)) return false;
   }
   matched_.push_back(group);

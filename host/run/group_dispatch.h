@@ -41,9 +41,11 @@ class GroupDispatch {
   bool merges() const { return session_.rank() == 0; }
 
   // Every rank calls Start() before its first look at the output folder,
-  // and Open() once its checkpoints are set up (run_checkpoint.h). The other
-  // ranks wait in Start() until rank 0 has reached Open(), so that they find
-  // its folder, its lock and its plan.json, and no claim of an earlier run.
+  // and Open() once its device and checkpoints are set up
+  // (run_checkpoint.h). The other ranks wait in Start() until rank 0 has
+  // reached Open(), so that they find its folder, its lock and its
+  // plan.json, and no claim of an earlier run; all wait in Open() until
+  // every rank is ready.
   void Start();
   void Open(const std::filesystem::path& dir);
 

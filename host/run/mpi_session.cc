@@ -90,10 +90,15 @@ MpiSession::~MpiSession() {
   if (!joined_) return;
   // Rank 0 may still be merging: the others wait here, asleep, rather than
   // in MPI_Finalize, which may spin.
+  Barrier();
+  MPI_Finalize();
+}
+
+void MpiSession::Barrier() {
+  if (size_ == 1) return;
   MPI_Request request;
   MPI_Ibarrier(MPI_COMM_WORLD, &request);
   WaitSleeping(&request);
-  MPI_Finalize();
 }
 
 std::string MpiSession::Broadcast(const std::string& text) {
@@ -138,6 +143,8 @@ MpiSession::MpiSession() {
 MpiSession::~MpiSession() = default;
 
 std::string MpiSession::Broadcast(const std::string& text) { return text; }
+
+void MpiSession::Barrier() {}
 
 std::vector<int> MpiSession::MaxOnRankZero(const std::vector<int>& values) { return values; }
 

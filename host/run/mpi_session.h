@@ -50,6 +50,8 @@ class MpiSession {
   // busy-waits in blocking calls, which would take a core from the ranks
   // still matching.
   std::string Broadcast(const std::string& text);
+  // Waits until every rank has called it; polls as Broadcast does.
+  void Barrier();
   // For each i, the largest of the ranks' values[i], on rank 0 (other ranks
   // get their own values back). Polls as Broadcast does.
   std::vector<int> MaxOnRankZero(const std::vector<int>& values);
