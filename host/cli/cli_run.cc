@@ -72,7 +72,9 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       "  sapmvs run block.yaml --out out/run --restart    discard the checkpoints\n"
       "  mpirun -np 2 sapmvs run block.yaml --out out/run --device 0,1\n"
       "                                                   groups over 2 processes, one GPU\n"
-      "                                                   each (built with MPI)\n"
+      "                                                   each (built with MPI); each rank\n"
+      "                                                   takes the machine's cores divided\n"
+      "                                                   by its ranks unless --threads N\n"
       "Outputs in DIR: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png (+ .pgw),\n"
       "report.json, groups/.");
   cmd->callback([o, block_flags, profile, profile_option, &global] {

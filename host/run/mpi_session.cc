@@ -133,7 +133,15 @@ void MpiSession::Abort(const std::string& message, int code) {
 #else  // One process.
 
 MpiSession::MpiSession() {
-  if (ReadLauncherEnvironment().ranks > 1) {
+  const LauncherEnvironment env = ReadLauncherEnvironment();
+  if (env.ranks > 1 && env.rank > 0) {
+    // Rank 0 says it for the job. The pause lets its line out before
+    // mpirun, seeing this exit, ends the others.
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    EndLog(1);
+    std::exit(1);
+  }
+  if (env.ranks > 1) {
     throw Error(
         "this sapmvs was built without MPI; install openmpi-bin libopenmpi-dev and rebuild "
         "(scripts/install-deps.sh)");
