@@ -142,7 +142,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   LogDetail("device: " + report.device);
 
   // Under mpirun rank 0 alone takes the folder and its lock, and writes
-  // plan.json; the others found them waiting in dispatch.Start().
+  // plan.json, while the others wait in dispatch.Start().
   std::unique_ptr<OutputFolder> folder;
   if (dispatch.merges()) {
     folder = std::make_unique<OutputFolder>(options.out, "run",
