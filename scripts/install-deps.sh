@@ -9,6 +9,8 @@ PACKAGES=(
   libeigen3-dev libopencv-dev libflann-dev
   libgdal-dev gdal-bin libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # `mpirun -np N sapmvs run` (optional: without them sapmvs builds as one process).
+  openmpi-bin libopenmpi-dev
   # scripts/fuzz.sh: clang with its sanitizer and libFuzzer runtimes and its
   # OpenMP; the symbolizer for sanitizer reports (also test.sh --sanitize).
   clang libclang-rt-14-dev libomp-dev llvm

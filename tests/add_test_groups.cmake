@@ -3,7 +3,8 @@
 # for the quick tests, so that a process (about 0.15 s to load OpenCV, GDAL
 # and PoCL) and the fixtures it builds serve the whole suite, and one per
 # test for those whose names match E2E (each its own process and timeout).
-# Labels: DEVICE (host or opencl) and fast or e2e.
+# Labels: DEVICE (host or opencl) and fast or e2e, and mpi for the e2e tests
+# that match MPI.
 execute_process(COMMAND "${EXE}" --gtest_list_tests OUTPUT_VARIABLE listing
                 RESULT_VARIABLE rc TIMEOUT 60)
 if(NOT rc EQUAL 0)
@@ -43,7 +44,11 @@ foreach(suite IN LISTS suites)
     endif()
   endif()
   foreach(test IN LISTS e2e_${suite})
-    add("${test}" "${test}" "${DEVICE};e2e")
+    if(MPI AND test MATCHES "${MPI}")
+      add("${test}" "${test}" "${DEVICE};e2e;mpi")
+    else()
+      add("${test}" "${test}" "${DEVICE};e2e")
+    endif()
     # A lone test that skips shows as skipped; a suite's skips are listed in
     # its output (a failure among them must not read as a skip).
     string(APPEND out "set_tests_properties([==[${test}]==] PROPERTIES"

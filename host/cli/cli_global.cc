@@ -28,7 +28,8 @@ void AddGlobalFlags(CLI::App& app, GlobalFlags* flags) {
   app.add_flag("-v,--verbose", flags->log.verbosity,
                "More detail on stderr: per-stage timings, GDAL's warnings");
   app.add_option("--threads", flags->threads,
-                 "Threads on the host and in PoCL's CPU device (0 = all cores)")
+                 "Threads on the host and in PoCL's CPU device (0 = all cores; under mpirun, "
+                 "`run` divides them among the ranks on one machine)")
       ->capture_default_str();
   app.add_option("--log", flags->log.file,
                  "Append everything printed, and the -v detail, with timestamps to FILE");

@@ -7,10 +7,12 @@
 #include <memory>
 
 #include "cli/cli.h"
+#include "run/mpi_session.h"
 #include "run/run_profile.h"
 #include "sapmvs/run/dense_run.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/thread_count.h"
 #include "util/option_flags.h"
 
 namespace sapmvs::cli {
@@ -68,6 +70,11 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       "  sapmvs run block.yaml --out out/run --max-groups 1   one group now; the same\n"
       "                                                   command later resumes\n"
       "  sapmvs run block.yaml --out out/run --restart    discard the checkpoints\n"
+      "  mpirun -np 2 sapmvs run block.yaml --out out/run --device 0,1\n"
+      "                                                   groups over 2 processes, one GPU\n"
+      "                                                   each (built with MPI); each rank\n"
+      "                                                   takes the machine's cores divided\n"
+      "                                                   by its ranks unless --threads N\n"
       "Outputs in DIR: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png (+ .pgw),\n"
       "report.json, groups/.");
   cmd->callback([o, block_flags, profile, profile_option, &global] {
@@ -76,7 +83,10 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
     o->matcher.progress = !global.quiet;
     o->command_line = global.command_line;
     if (o->profile && !profile->empty()) CheckProfilePath(*profile, o->out);
+    // Before the OpenCL platform is loaded, as ApplyGlobalFlags does.
+    if (global.threads == 0) SetThreadCount(RankThreadCount());
     const RunReport report = RunDense(*o);
+    if (report.rank != 0) return;  // rank 0 prints for the whole job
     PrintRunSummary(report, std::cout);
     if (o->profile) {
       PrintProfile(report, std::cout);

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cstdlib>
 #include <string_view>
+#include <vector>
 
 #include "match/patch_kernels.h"
 
@@ -24,6 +25,19 @@ DeviceSpec DeviceSpecFor(const std::string& device) {
     if (std::string spec = Trim(env); !spec.empty()) return {spec, "SAPMVS_DEVICE"};
   }
   return {};
+}
+
+std::string DeviceForLocalRank(const std::string& device, int local_rank) {
+  const DeviceSpec spec = DeviceSpecFor(device);
+  if (spec.value.find(',') == std::string::npos) return device;
+  std::vector<std::string> entries;
+  for (size_t begin = 0;;) {
+    const size_t end = spec.value.find(',', begin);
+    entries.push_back(Trim(std::string_view(spec.value).substr(begin, end - begin)));
+    if (end == std::string::npos) break;
+    begin = end + 1;
+  }
+  return entries[static_cast<size_t>(local_rank) % entries.size()];
 }
 
 bool IsReferenceSpec(const DeviceSpec& spec) {

@@ -13,7 +13,10 @@
 #include <sstream>
 
 #include "device/make_patch_kernels.h"
+#include "match/device_spec.h"
 #include "match/patch_kernels.h"
+#include "run/group_dispatch.h"
+#include "run/mpi_session.h"
 #include "run/run_checkpoint.h"
 #include "run/run_report.h"
 #include "sapmvs/block/block_geometry.h"
@@ -95,15 +98,14 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   sum->gsd = s.gsd;
 }
 
-}  // namespace
-
-RunReport RunDense(const RunOptions& options) {
+RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
+  dispatch.Start();
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("run: expected " + problem);
   // Everything that can be refused is checked before the first file is
   // written, so a failed start leaves nothing that stops the corrected
   // command: the folder, the block and its CRS, the device.
-  OutputFolder::Check(options.out, "run");
+  if (dispatch.merges()) OutputFolder::Check(options.out, "run");
   const auto start = std::chrono::steady_clock::now();
   RunReport report;
   report.out = options.out;
@@ -130,7 +132,7 @@ RunReport RunDense(const RunOptions& options) {
   // The device before the plan, which counts its runtime's memory; after the
   // geometry, whose DEM would otherwise add to the runtime's peak.
   PatchKernelsOptions kernel_options;
-  kernel_options.device = options.device;
+  kernel_options.device = DeviceForLocalRank(options.device, dispatch.session().local_rank());
   kernel_options.profile = options.profile;
   const std::unique_ptr<PatchKernels> kernels = MakePatchKernels(kernel_options);
   const KernelDevice& device = kernels->device();
@@ -139,19 +141,31 @@ RunReport RunDense(const RunOptions& options) {
   LogDetail("device: " + report.device);
 
   // What the process holds before any group, once what planning freed is
-  // handed back: every group's estimate adds it.
+  // handed back: every group's estimate adds it (rank 0's under mpirun, so
+  // that the ranks' plans agree).
   ReleaseFreeMemory();
-  const GroupingPlan plan =
-      PlanGroups(block, options.grouping, options.matcher, &geometry, CurrentRssBytes());
+  const GroupingPlan plan = PlanGroups(block, options.grouping, options.matcher, &geometry,
+                                       dispatch.PlanProcessBytes(CurrentRssBytes()));
   report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
   for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   end_stage("plan");
 
-  const OutputFolder folder(options.out, "run", {"groups"});
-  if (options.restart) RemoveRunOutputs(options.out);
-  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher, options.restart);
+  // Under mpirun rank 0 alone takes the folder and its lock, and writes
+  // plan.json, while the others wait in dispatch.Start().
+  std::unique_ptr<OutputFolder> folder;
+  if (dispatch.merges()) {
+    folder = std::make_unique<OutputFolder>(options.out, "run",
+                                            std::vector<std::filesystem::path>{"groups"});
+    if (options.restart) RemoveRunOutputs(options.out);
+  }
+  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher,
+                             options.restart && dispatch.merges());
+  dispatch.Open(options.out / "groups");
+  report.ranks = dispatch.session().size();
+  report.rank = dispatch.session().rank();
 
-  const bool show = options.matcher.progress && Progress::TerminalAllowsProgress();
+  const bool show =
+      options.matcher.progress && dispatch.merges() && Progress::TerminalAllowsProgress();
   const int n = static_cast<int>(plan.groups.size());
   // The groups this call will match, for the ETA: not checkpointed, and at
   // most max_groups of them.
@@ -184,6 +198,10 @@ RunReport RunDense(const RunOptions& options) {
       report.groups.push_back(run);
       continue;
     }
+    if (!dispatch.Claim(g)) {  // another rank's
+      report.groups.push_back(run);
+      continue;
+    }
     progress.StartGroup(g, n, static_cast<long>(plan.groups[g].images.size()));
     const auto t0 = std::chrono::steady_clock::now();
     ReleaseFreeMemory();  // what the groups before freed
@@ -210,7 +228,18 @@ RunReport RunDense(const RunOptions& options) {
     report.groups.push_back(run);
   }
   progress.Finish();
+  const std::vector<int> matched_by = dispatch.Finish(n);
   end_stage("match");
+  if (!dispatch.merges()) return report;
+  for (GroupRun& run : report.groups) {
+    run.rank = report.ranks > 1 ? matched_by[run.index] : -1;
+    if (run.rank <= 0 || !checkpoints.Done(run.index)) continue;
+    const GroupCheckpoint c = checkpoints.Read(run.index);  // matched by another rank
+    run.points = c.points;
+    run.seconds = c.seconds;
+    run.memory = c.memory;
+  }
+  for (int g = 0; g < n; ++g) stopped = stopped || !checkpoints.Done(g);
   if (stopped) {
     report.total_seconds = Since(start);
     report.peak_rss_bytes = ProcessPeakRssBytes();
@@ -266,10 +295,29 @@ RunReport RunDense(const RunOptions& options) {
   return report;
 }
 
+}  // namespace
+
+RunReport RunDense(const RunOptions& options) {
+  MpiSession session;  // one process unless mpirun started this one
+  GroupDispatch dispatch(session);
+  if (session.size() == 1) return RunGroups(options, dispatch);
+  // The other ranks would wait for this one forever: the first error ends
+  // the job.
+  try {
+    return RunGroups(options, dispatch);
+  } catch (const Error& e) {
+    session.Abort(e.what(), e.ExitCode());
+  } catch (const std::exception& e) {
+    session.Abort(e.what(), 1);
+  }
+}
+
 void PrintRunSummary(const RunReport& report, std::ostream& out) {
   const MatchStats& s = report.stats;
   out << "device        " << report.device << "\n";
-  out << "groups        " << report.groups.size() << " (" << report.strategy << ")\n";
+  out << "groups        " << report.groups.size() << " (" << report.strategy << ")";
+  if (report.ranks > 1) out << " on " << report.ranks << " MPI ranks";
+  out << "\n";
   if (!report.ungrouped.empty()) {
     out << "ungrouped     " << report.ungrouped.size() << " images in no group (not matched):";
     for (const std::string& name : report.ungrouped) out << " " << name;
@@ -280,6 +328,9 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
         << " images  ";
     if (g.resumed) {
       out << std::setw(9) << g.points << " points  (checkpoint)";
+    } else if (g.rank > 0) {
+      out << std::setw(9) << g.points << " points  " << FormatHms(g.seconds) << " on rank "
+          << g.rank;
     } else if (g.seconds > 0 || g.points > 0) {
       out << std::setw(9) << g.points << " points  " << FormatHms(g.seconds);
     }

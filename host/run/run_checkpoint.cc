@@ -40,7 +40,7 @@ bool IsGroupCheckpointName(const std::string& name) {
   const std::string digits = name.substr(6, dot - 6);
   const std::string ext = name.substr(dot);
   return digits.find_first_not_of("0123456789") == std::string::npos &&
-         (ext == ".ply" || ext == ".json");
+         (ext == ".ply" || ext == ".json" || ext == ".claim");
 }
 
 }  // namespace

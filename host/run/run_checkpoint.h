@@ -26,7 +26,7 @@ struct GroupCheckpoint {
 // and its side-car, dsm.png, report.json, profile.csv/json) and its
 // checkpoints in out/groups, by name: a user's other files there stay.
 void RemoveRunOutputs(const std::filesystem::path& out);
-// plan.json and group_NNN.ply/.json in `dir`, and nothing else.
+// plan.json and group_NNN.ply/.json/.claim in `dir`, and nothing else.
 void RemoveCheckpoints(const std::filesystem::path& dir);
 
 class RunCheckpoints {

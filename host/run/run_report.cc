@@ -113,6 +113,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["bounds"] = {{"min", Xyz(report.bounds_min)}, {"max", Xyz(report.bounds_max)}};
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["images"] = report.images;
+  if (report.ranks > 1) j["mpi_ranks"] = report.ranks;
   j["points"] = report.points;
   j["total_seconds"] = report.total_seconds;
   j["total_hms"] = FormatHms(report.total_seconds);
@@ -130,6 +131,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
     nlohmann::json e = {{"group", r.index + 1},        {"images", r.images},
                         {"points", r.points},          {"seconds", r.seconds},
                         {"hms", FormatHms(r.seconds)}, {"from_checkpoint", r.resumed}};
+    if (report.ranks > 1 && r.rank >= 0) e["rank"] = r.rank;
     if (g < plan.groups.size()) {
       const Eigen::Vector2d c = plan.groups[g].center + block.origin.head<2>();
       e["center"] = {c.x(), c.y()};

@@ -25,6 +25,7 @@ struct RunOptions {
   std::filesystem::path out;  // output folder, created when missing
   // OpenCL device: index or name substring, or "reference" for the CPU
   // reference backend ("" = SAPMVS_DEVICE, else the default OpenCL device).
+  // Under mpirun a comma list: rank r of a machine takes entry r mod n.
   std::string device;
   MatcherOptions matcher;
   // The plan is made for `matcher` (its level and min_image_num).
@@ -62,7 +63,8 @@ void VisitFields(RunOptions& o, F&& f) {
         .Flag("--device")
         .In("Device")
         .Help("OpenCL device: index or name substring (see `sapmvs devices`), or "
-              "`reference` for the CPU reference (no OpenCL)"));
+              "`reference` for the CPU reference (no OpenCL); under mpirun a comma list, "
+              "e.g. 0,1: the machine's rank r takes entry r mod n"));
   f(Field(o.restart, "restart")
         .Flag("--restart")
         .In("Output and resume")

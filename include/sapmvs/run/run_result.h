@@ -35,6 +35,7 @@ struct GroupRun {
   long points = 0;
   double seconds = 0;
   bool resumed = false;              // read from a checkpoint of an earlier call
+  int rank = -1;                     // under mpirun, the rank that matched it in this call
   double memory_estimate_bytes = 0;  // the plan's (GroupMemory::Total)
   GroupMemoryUse memory;
 };
@@ -55,6 +56,10 @@ struct RunReport {
   std::chrono::system_clock::time_point start_time, end_time;
   std::string strategy;
   bool finished = false;  // false: stopped by max_groups, outputs not written
+  // Under mpirun: the processes and this one's rank. Only rank 0 merges,
+  // writes the outputs and prints the summary.
+  int ranks = 1;
+  int rank = 0;
   int images = 0;
   std::vector<GroupRun> groups;
   std::vector<std::string> ungrouped;  // images the plan put in no group (grouping.h)
