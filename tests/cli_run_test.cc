@@ -214,6 +214,49 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
   EXPECT_EQ(files, expected);
 }
 
+// Each group's measured peak sits beside the plan's estimate, within the
+// issue's 25 %; a budget below the default group splits the block, and the
+// run stays within it (plus the 10 %).
+TEST_F(CliRunTest, MemoryEstimateHoldsAndABudgetSplitsTheBlock) {
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  auto check_groups = [](const nlohmann::json& report) {
+    for (const auto& g : report.at("groups")) {
+      const double estimate = g.at("memory_estimate_bytes").at("total").get<double>();
+      const auto& measured = g.at("memory_measured_bytes");
+      const double peak = measured.at("peak_rss").get<double>();
+      EXPECT_GT(measured.at("rss_before").get<double>(), 0) << g;
+      EXPECT_LE(measured.at("rss_before").get<double>(), peak) << g;
+      EXPECT_GT(measured.at("device_peak").get<double>(), 0) << g;
+      EXPECT_NEAR(estimate / peak, 1.0, 0.25) << g;
+    }
+  };
+  const auto [out, r] = test::SharedRun(Block(), "-q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(out / "report.json");
+  const nlohmann::json whole = nlohmann::json::parse(in);
+  ASSERT_EQ(whole.at("groups").size(), 1u);
+  check_groups(whole);
+
+  // Room for the process and three quarters of what the group of 4 adds on
+  // the device and the host: two groups of 2 (one per strip, --min-image-num 2).
+  const auto& estimate = whole.at("groups")[0].at("memory_estimate_bytes");
+  const double budget =
+      estimate.at("total").get<double>() -
+      0.25 * (estimate.at("device").get<double>() + estimate.at("host").get<double>());
+  const auto split =
+      RunCli("run " + Block().string() + " --out " + out_.string() +
+             " --min-image-num 2 -q --memory-budget " + std::to_string(static_cast<long>(budget)));
+  ASSERT_EQ(split.exit_code, 0) << split.err;
+  std::ifstream split_in(out_ / "report.json");
+  const nlohmann::json parts = nlohmann::json::parse(split_in);
+  EXPECT_GE(parts.at("groups").size(), 2u);
+  check_groups(parts);
+  for (const auto& part : parts.at("groups")) {
+    EXPECT_LE(part.at("memory_estimate_bytes").at("total").get<double>(), budget) << part;
+  }
+  EXPECT_LE(parts.at("peak_rss_bytes").get<double>(), 1.1 * budget);
+}
+
 // An ODM project (reference_lla, no CRS of its own) comes out in UTM 51N:
 // `info` says so, and cloud.las, dsm.tif and report.json carry EPSG:32651.
 TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {

@@ -48,6 +48,7 @@ MatcherMemoryModel MatcherMemory() {
   m.device_bytes_per_candidate = batch.per_patch + views * batch.per_pair;
   m.host_bytes_per_candidate =
       sizeof(PatchCandidate) + sizeof(std::optional<AcceptedPatch>) + 4 * views;
+  m.runtime_warmup_bytes = 24.0 * (1 << 20);
   return m;
 }
 

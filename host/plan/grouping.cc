@@ -470,6 +470,9 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   if (!(std::isfinite(process_bytes) && process_bytes >= 0))
     throw Error("grouping: expected the process's memory >= 0 (process_bytes = " +
                 std::to_string(process_bytes) + ")");
+  // A process that has not matched yet will still grow by the runtime's
+  // warm-up in its first group (MatcherMemoryModel).
+  if (process_bytes > 0) process_bytes += MatcherMemory().runtime_warmup_bytes;
   CheckSmallestGroupFits(block, options, matcher, process_bytes);
   GroupingPlan plan;
   plan.process_bytes = process_bytes;

@@ -118,8 +118,9 @@ struct GroupingPlan {
 // `geometry`: EstimateBlockGeometry(block) when the caller has it (it reads
 // the block's DEM), else nullptr and it is estimated here.
 // `process_bytes`: what the process that will match holds before any group
-// (run: its RSS once the block is read and the device set up), added to
-// every group's estimate; 0 = the groups' own memory only.
+// (run: its RSS once the block is read and the device set up); with the
+// runtime's warm-up (MatcherMemoryModel::runtime_warmup_bytes) it is added
+// to every group's estimate. 0 = the groups' own memory only.
 GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
                         const MatcherOptions& matcher, const BlockGeometry* geometry = nullptr,
                         double process_bytes = 0);
