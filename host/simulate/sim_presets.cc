@@ -120,8 +120,8 @@ const std::vector<Preset>& AllPresets() {
       // A block big enough to show how a run scales (1,000 images, 170
       // groups) at an image size that keeps it within minutes on 2 cores:
       // tiny's camera and flight at half the resolution. The scene raster
-      // grows with the ground (about 2.7 x 1.8 km); one cell per GSD keeps
-      // it near 20 M cells (240 MB with the truth rasters) where tiny's half
+      // grows with the ground (about 2.8 x 1.8 km); one cell per GSD keeps
+      // it near 18 M cells (about 210 MB with the truth rasters) where tiny's half
       // GSD would take four times that.
       Preset l;
       l.name = "large";
