@@ -119,6 +119,7 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
                                    return !reach.Holds(p.position.x(), p.position.y());
                                  }),
                   pts.end());
+        pts.shrink_to_fit();  // the tile holds its share of the group, not the whole
       }
       MergeStats tile_stats;
       const std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats);

@@ -117,7 +117,7 @@ const std::vector<Preset>& AllPresets() {
       p.push_back(c);
     }
     {
-      // A block big enough to show how a run scales (1,000 images, 170
+      // A block big enough to show how a run scales (1,000 images, 180
       // groups) at an image size that keeps it within minutes on 2 cores:
       // tiny's camera and flight at half the resolution. The scene raster
       // grows with the ground (about 2.8 x 1.8 km); one cell per GSD keeps

@@ -29,7 +29,7 @@ struct MergeOptions {
   double radius = 0;
   // The tiled merge (tiled_merge.h): about this many group points per tile;
   // a block with no more than these is merged in one piece (>= 1000).
-  long tile_points = 500000;  // RunOptions::merge_tile_points gives it
+  long tile_points = 250000;  // RunOptions::merge_tile_points gives it
   // The tiled merge's halo: each tile is merged with the points within this
   // many radii around it, and keeps only its own (>= 1).
   double halo_radii = 8;

@@ -41,7 +41,7 @@ struct RunOptions {
   // Merge tile by tile, about this many group points a tile, so that the
   // merge, the DSM and the writers never hold the block's points at once;
   // a block with fewer is merged whole (tiled_merge.h). >= 1000.
-  int merge_tile_points = 500000;
+  int merge_tile_points = 250000;
   DsmOptions dsm;
   // cloud.las: LAS 1.2 by default, which every reader opens (las_io.h).
   LasVersion las_version = LasWriteOptions{}.version;
