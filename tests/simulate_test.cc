@@ -364,6 +364,42 @@ TEST(Simulate, OverlapFlagSetsBaseAndStripSpacing) {
   }
 }
 
+TEST(Simulate, StripFlagsCutTheLargeFlight) {
+  SimulateOptions o;
+  o.preset = "large";
+  o.out = "unused";
+  const sim::FlightPlan whole = PlanSimulatedFlight(o);
+  EXPECT_EQ(whole.images.size(), 1000u);
+  EXPECT_EQ(whole.strips, 20);
+  o.strips = 5;
+  o.strip_images = 20;
+  const sim::FlightPlan part = PlanSimulatedFlight(o);
+  ASSERT_EQ(part.images.size(), 100u);
+  EXPECT_EQ(part.strips, 5);
+  // The same flight cut shorter: camera, GSD, base and strip spacing stay.
+  EXPECT_EQ(part.gsd, whole.gsd);
+  EXPECT_EQ(part.base, whole.base);
+  EXPECT_EQ(part.strip_spacing, whole.strip_spacing);
+  std::map<int, int> per_strip;
+  for (const PlannedImage& im : part.images) ++per_strip[im.strip];
+  for (const auto& [strip, n] : per_strip) EXPECT_EQ(n, 20) << "strip " << strip;
+  // One flag alone keeps the preset's other count (campus: 4 strips, longest 18).
+  SimulateOptions c;
+  c.preset = "campus";
+  c.out = "unused";
+  c.strips = 2;
+  EXPECT_EQ(PlanSimulatedFlight(c).images.size(), 36u);
+  c.strips = 0;
+  c.strip_images = 3;
+  EXPECT_EQ(PlanSimulatedFlight(c).images.size(), 12u);
+  for (const auto& [strips, images] : {std::pair{-1, 0}, {501, 0}, {0, 1}, {0, 1001}}) {
+    c.strips = strips;
+    c.strip_images = images;
+    EXPECT_FALSE(c.Problem().empty()) << strips << " " << images;
+    EXPECT_THROW(PlanSimulatedFlight(c), Error);
+  }
+}
+
 TEST(Simulate, CampusAndMountainFlyThePapersBases) {
   // Table 2: about 50 m between exposures at 700 m; Table 5: about 108 m
   // at about 1,900 m (GSD 0.451 m at full resolution).

@@ -52,6 +52,17 @@ Dem Dem::Load(const std::filesystem::path& path) {
       z = std::numeric_limits<float>::quiet_NaN();
     }
   }
+  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+  for (float z : dem.z_) {
+    if (std::isfinite(z)) {
+      zmin = std::min(zmin, static_cast<double>(z));
+      zmax = std::max(zmax, static_cast<double>(z));
+    }
+  }
+  if (std::isfinite(zmax)) {
+    dem.zmin_ = zmin;
+    dem.zmax_ = zmax;
+  }
   return dem;
 }
 
@@ -76,13 +87,7 @@ Eigen::Vector3d Dem::Intersect(const Eigen::Vector3d& center, const Eigen::Vecto
   if (!(d.z() < 0)) return Eigen::Vector3d::Constant(kNaN);
   // Start where the ray reaches the highest plausible surface, step half a
   // cell (in 3D) and refine the crossing by bisection.
-  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
-  for (float z : z_) {
-    if (std::isfinite(z)) {
-      zmin = std::min(zmin, static_cast<double>(z));
-      zmax = std::max(zmax, static_cast<double>(z));
-    }
-  }
+  const double zmin = zmin_, zmax = zmax_;
   if (!std::isfinite(zmax)) return Eigen::Vector3d::Constant(kNaN);
   double t = std::max(0.0, (center.z() - zmax) / -d.z());
   const double step = 0.5 * cell_size();

@@ -33,6 +33,10 @@ void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global) {
                   "ground, e.g. 88,30 (default: the preset's)")
       ->delimiter(',')
       ->allow_extra_args(false);
+  cmd->add_option("--strips", o->strips,
+                  "Strips to fly, all of --strip-images (default: the preset's)");
+  cmd->add_option("--strip-images", o->strip_images,
+                  "Images per strip (default: the preset's longest strip)");
   cmd->add_option("--exposure", o->exposure,
                   "Largest relative exposure change between images (default: the preset's)");
   cmd->add_option("--supersampling", o->supersampling, "Rays per pixel side (2 = 2x2)")

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "io/las_extra_bytes.h"
 #include "sapmvs/io/raster_io.h"
@@ -71,22 +72,16 @@ struct Quantization {
   std::array<double, 3> scale{}, offset{}, lo{}, hi{};
 };
 
-Quantization ChooseQuantization(const std::filesystem::path& path,
-                                const std::vector<PointRecord>& points, double user_scale,
-                                bool geographic) {
+Quantization ChooseQuantization(const std::filesystem::path& path, const LasCounts& counts,
+                                double user_scale, bool geographic) {
   constexpr const char* kAxis[3] = {"X", "Y", "Z"};
   Quantization q;
-  if (points.empty()) {
+  if (counts.count == 0) {
     q.scale.fill(user_scale > 0 ? user_scale : 0.001);
     return q;
   }
   for (int a = 0; a < 3; ++a) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const PointRecord& p : points) {
-      const double v = a == 0 ? p.x : a == 1 ? p.y : p.z;
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
+    const double lo = counts.lo[a], hi = counts.hi[a];
     q.offset[a] = std::round(0.5 * lo + 0.5 * hi);  // lo + hi may overflow
     const double reach = std::max(hi - q.offset[a], q.offset[a] - lo);
     if (user_scale > 0) {
@@ -114,35 +109,8 @@ int32_t Quantize(double v, double scale, double offset) {
 // The point format each version is written in.
 int WriteFormat(LasVersion v) { return v == LasVersion::k12 ? 2 : 7; }
 
-void CheckPoints(const std::filesystem::path& path, const std::vector<PointRecord>& points,
-                 LasVersion version) {
-  const bool v12 = version == LasVersion::k12;
-  const int max_return = v12 ? 7 : 15;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const PointRecord& p = points[i];
-    const std::string at = path.string() + ": point " + std::to_string(i);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      throw Error(at + " is (" + FormatNumber(p.x, 12) + ", " + FormatNumber(p.y, 12) + ", " +
-                  FormatNumber(p.z, 12) + "); expected finite coordinates");
-    }
-    if (p.return_number > max_return || p.number_of_returns > max_return) {
-      throw Error(at + " has return " + std::to_string(p.return_number) + " of " +
-                  std::to_string(p.number_of_returns) + "; expected at most " +
-                  std::to_string(max_return) + " in LAS " + ToString(version));
-    }
-    if (v12 && p.classification > 31) {
-      throw Error(at + " has class " + std::to_string(p.classification) +
-                  "; expected at most 31 in LAS 1.2 (LAS 1.4 holds up to 255)");
-    }
-  }
-  if (v12 && points.size() > std::numeric_limits<uint32_t>::max()) {
-    throw Error(path.string() + ": " + std::to_string(points.size()) +
-                " points; LAS 1.2 holds at most 4294967295 (use LAS 1.4)");
-  }
-}
-
-std::vector<uint8_t> MakeHeader(const std::vector<PointRecord>& points, const Quantization& q,
-                                size_t vlr_bytes, uint32_t vlr_count, size_t record_length,
+std::vector<uint8_t> MakeHeader(const LasCounts& counts, const Quantization& q, size_t vlr_bytes,
+                                uint32_t vlr_count, size_t record_length,
                                 const LasWriteOptions& options) {
   const bool v12 = options.version == LasVersion::k12;
   const size_t size = v12 ? kHeaderSize12 : kHeaderSize14;
@@ -165,14 +133,11 @@ std::vector<uint8_t> MakeHeader(const std::vector<PointRecord>& points, const Qu
   Put<uint32_t>(&h[100], vlr_count);
   h[104] = static_cast<uint8_t>(WriteFormat(options.version));
   Put<uint16_t>(&h[105], static_cast<uint16_t>(record_length));
-  uint64_t by_return[15] = {};
-  for (const PointRecord& p : points) {
-    if (p.return_number >= 1) ++by_return[p.return_number - 1];
-  }
+  const auto& by_return = counts.by_return;
   // LAS 1.4 forbids the legacy counts (bytes 107-130) for formats 6-10; LAS
   // 1.2 has only them, returns 1-5.
   if (v12) {
-    Put<uint32_t>(&h[107], static_cast<uint32_t>(points.size()));
+    Put<uint32_t>(&h[107], static_cast<uint32_t>(counts.count));
     for (int r = 0; r < 5; ++r) Put<uint32_t>(&h[111 + 4 * r], static_cast<uint32_t>(by_return[r]));
   }
   for (int a = 0; a < 3; ++a) {
@@ -182,7 +147,7 @@ std::vector<uint8_t> MakeHeader(const std::vector<PointRecord>& points, const Qu
     Put<double>(&h[187 + 16 * a], q.lo[a]);
   }
   if (!v12) {
-    Put<uint64_t>(&h[247], points.size());
+    Put<uint64_t>(&h[247], counts.count);
     for (int r = 0; r < 15; ++r) Put<uint64_t>(&h[255 + 8 * r], by_return[r]);
   }
   return h;
@@ -324,15 +289,62 @@ std::string LasWriteOptions::Problem() const {
   return "";
 }
 
-void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>& points,
-              const LasWriteOptions& options, const std::vector<LasExtraField>& extras) {
+void LasCounts::Add(const std::filesystem::path& path, const PointRecord& p, LasVersion version) {
+  const bool v12 = version == LasVersion::k12;
+  const int max_return = v12 ? 7 : 15;
+  const std::string at = path.string() + ": point " + std::to_string(count);
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+    throw Error(at + " is (" + FormatNumber(p.x, 12) + ", " + FormatNumber(p.y, 12) + ", " +
+                FormatNumber(p.z, 12) + "); expected finite coordinates");
+  }
+  if (p.return_number > max_return || p.number_of_returns > max_return) {
+    throw Error(at + " has return " + std::to_string(p.return_number) + " of " +
+                std::to_string(p.number_of_returns) + "; expected at most " +
+                std::to_string(max_return) + " in LAS " + ToString(version));
+  }
+  if (v12 && p.classification > 31) {
+    throw Error(at + " has class " + std::to_string(p.classification) +
+                "; expected at most 31 in LAS 1.2 (LAS 1.4 holds up to 255)");
+  }
+  const double v[3] = {p.x, p.y, p.z};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::min(lo[a], v[a]);
+    hi[a] = std::max(hi[a], v[a]);
+  }
+  if (p.return_number >= 1) ++by_return[p.return_number - 1];
+  ++count;
+}
+
+void WidenExtraRanges(const std::filesystem::path& path, const std::vector<LasExtraField>& chunk,
+                      size_t points, std::vector<LasExtraField>* ranges) {
+  if (const std::string problem = las::ExtraFieldsProblem(chunk, points); !problem.empty()) {
+    throw Error(path.string() + ": " + problem);
+  }
+  if (ranges->empty()) {
+    for (const LasExtraField& f : chunk) ranges->push_back({f.name, f.description, f.type, {}});
+  }
+  for (size_t k = 0; k < chunk.size() && k < ranges->size(); ++k) {
+    std::vector<double>& r = (*ranges)[k].values;
+    for (const double v : chunk[k].values) {
+      if (r.empty()) {
+        r = {v, v};
+      } else {
+        r[0] = std::min(r[0], v);
+        r[1] = std::max(r[1], v);
+      }
+    }
+  }
+}
+
+void WriteLasStream(const std::filesystem::path& path, const LasCounts& counts,
+                    const LasWriteOptions& options, const std::vector<LasExtraField>& ranges,
+                    const NextLasPoints& next) {
   if (const std::string problem = options.Problem(); !problem.empty()) {
     throw Error(path.string() + ": " + problem);
   }
-  CheckPoints(path, points, options.version);
-  if (const std::string problem = las::ExtraFieldsProblem(extras, points.size());
-      !problem.empty()) {
-    throw Error(path.string() + ": " + problem);
+  if (options.version == LasVersion::k12 && counts.count > std::numeric_limits<uint32_t>::max()) {
+    throw Error(path.string() + ": " + std::to_string(counts.count) +
+                " points; LAS 1.2 holds at most 4294967295 (use LAS 1.4)");
   }
   const std::string wkt = CrsToWkt(options.crs);
   bool geographic = false;
@@ -340,19 +352,15 @@ void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>&
     OGRSpatialReference srs;
     geographic = srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic();
   }
-  Quantization q = ChooseQuantization(path, points, options.scale, geographic);
-  if (!points.empty()) {
-    q.lo.fill(std::numeric_limits<double>::infinity());
-    q.hi.fill(-std::numeric_limits<double>::infinity());
-  }
-  for (const PointRecord& p : points) {
-    const double v[3] = {p.x, p.y, p.z};
-    for (int a = 0; a < 3; ++a) {
-      const double stored =
-          Dequantize(Quantize(v[a], q.scale[a], q.offset[a]), q.scale[a], q.offset[a]);
-      q.lo[a] = std::min(q.lo[a], stored);
-      q.hi[a] = std::max(q.hi[a], stored);
-    }
+  Quantization q = ChooseQuantization(path, counts, options.scale, geographic);
+  // The stored (quantized) extent: quantizing and back is monotonic, so the
+  // extremes of the stored coordinates are those of the given ones.
+  for (int a = 0; a < 3 && counts.count > 0; ++a) {
+    auto stored = [&](double v) {
+      return Dequantize(Quantize(v, q.scale[a], q.offset[a]), q.scale[a], q.offset[a]);
+    };
+    q.lo[a] = stored(counts.lo[a]);
+    q.hi[a] = stored(counts.hi[a]);
   }
   std::vector<uint8_t> vlrs;
   uint32_t vlr_count = 0;
@@ -369,33 +377,63 @@ void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>&
               std::vector<uint8_t>(wkt.c_str(), wkt.c_str() + wkt.size() + 1), &vlrs);
     ++vlr_count;
   }
-  if (!extras.empty()) {
+  if (!ranges.empty()) {
     AppendVlr(path, las::kSpecUserId, las::kExtraBytesRecordId, "Extra Bytes",
-              las::EncodeExtraDescriptors(extras), &vlrs);
+              las::EncodeExtraDescriptors(ranges), &vlrs);
     ++vlr_count;
   }
   const int format = WriteFormat(options.version);
   const size_t base = kMinRecordLength[format];
   size_t record = base;
-  for (const LasExtraField& f : extras) record += las::ExtraTypeSize(f.type);
+  for (const LasExtraField& f : ranges) record += las::ExtraTypeSize(f.type);
   const std::vector<uint8_t> header =
-      MakeHeader(points, q, vlrs.size(), vlr_count, record, options);
+      MakeHeader(counts, q, vlrs.size(), vlr_count, record, options);
 
   WriteStreamAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(header.data()), header.size());
     out.write(reinterpret_cast<const char*>(vlrs.data()), vlrs.size());
     std::vector<uint8_t> buf(kChunkPoints * record);
-    for (size_t first = 0; first < points.size(); first += kChunkPoints) {
-      const size_t n = std::min(kChunkPoints, points.size() - first);
-      std::fill(buf.begin(), buf.end(), 0);
-      for (size_t i = 0; i < n; ++i) {
-        EncodePoint(points[first + i], q, format, &buf[i * record]);
-        las::EncodeExtraValues(extras, first + i, &buf[i * record + base]);
+    const std::vector<PointRecord>* chunk = nullptr;
+    const std::vector<LasExtraField>* chunk_extras = nullptr;
+    size_t written = 0;
+    while (written <= counts.count && next(&chunk, &chunk_extras)) {
+      const std::vector<PointRecord>& points = *chunk;
+      for (size_t first = 0; first < points.size(); first += kChunkPoints) {
+        const size_t n = std::min(kChunkPoints, points.size() - first);
+        std::fill(buf.begin(), buf.end(), 0);
+        for (size_t i = 0; i < n; ++i) {
+          EncodePoint(points[first + i], q, format, &buf[i * record]);
+          las::EncodeExtraValues(*chunk_extras, first + i, &buf[i * record + base]);
+        }
+        out.write(reinterpret_cast<const char*>(buf.data()),
+                  static_cast<std::streamsize>(n * record));
       }
-      out.write(reinterpret_cast<const char*>(buf.data()),
-                static_cast<std::streamsize>(n * record));
+      written += points.size();
+    }
+    if (written != counts.count) {
+      throw Error(path.string() + ": " + std::to_string(counts.count) +
+                  " points declared, more or fewer given (expected the same points twice)");
     }
   });
+}
+
+void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>& points,
+              const LasWriteOptions& options, const std::vector<LasExtraField>& extras) {
+  if (const std::string problem = options.Problem(); !problem.empty()) {
+    throw Error(path.string() + ": " + problem);
+  }
+  LasCounts counts;
+  for (const PointRecord& p : points) counts.Add(path, p, options.version);
+  std::vector<LasExtraField> ranges;
+  WidenExtraRanges(path, extras, points.size(), &ranges);
+  bool given = false;
+  WriteLasStream(
+      path, counts, options, ranges,
+      [&](const std::vector<PointRecord>** chunk, const std::vector<LasExtraField>** chunk_extras) {
+        *chunk = &points;
+        *chunk_extras = &extras;
+        return !std::exchange(given, true);
+      });
 }
 
 LasCloud ReadLas(const std::filesystem::path& path, bool extra_values) {

@@ -24,8 +24,7 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "PLY I/O assumes a litt
 // is not PLY (a binary file read as text would otherwise be slurped whole).
 constexpr size_t kMaxHeaderLineLength = 1 << 16;
 constexpr int kMaxHeaderLines = 100000;
-// Points per write call and bytes per read refill: a few MB at most.
-constexpr size_t kPlyChunkPoints = 1 << 16;
+// Bytes per read refill.
 constexpr size_t kReadBufferSize = 1 << 20;
 
 enum class PlyType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
@@ -492,85 +491,6 @@ PointCloud ReadPly(const std::filesystem::path& path) {
     ReadBinaryElement(&cursor, file, *e, swap, e == vertex ? &cloud.points : nullptr);
   }
   return cloud;
-}
-
-void WritePly(const std::filesystem::path& path, const PointCloud& cloud) {
-  const std::string file = path.string();
-  bool views_fit_uchar = true;
-  for (size_t i = 0; i < cloud.points.size(); ++i) {
-    const CloudPoint& p = cloud.points[i];
-    if (!p.position.allFinite()) {
-      throw Error(file + ": point " + std::to_string(i) +
-                  " has a non-finite coordinate (expected finite x y z)");
-    }
-    if (cloud.has_views && p.num_views < 0) {
-      throw Error(file + ": point " + std::to_string(i) + " has " + std::to_string(p.num_views) +
-                  " views (expected a count >= 0)");
-    }
-    views_fit_uchar = views_fit_uchar && p.num_views <= 255;
-  }
-
-  std::ostringstream header;
-  header << "ply\nformat binary_little_endian 1.0\ncomment written by sapmvs\n";
-  if (!cloud.crs.empty()) {
-    std::string crs = cloud.crs;
-    std::replace_if(
-        crs.begin(), crs.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-    header << "comment crs " << crs << "\n";
-  }
-  header << "element vertex " << cloud.points.size() << "\n"
-         << "property double x\nproperty double y\nproperty double z\n";
-  size_t record = 24;
-  if (cloud.has_normals) {
-    header << "property float nx\nproperty float ny\nproperty float nz\n";
-    record += 12;
-  }
-  if (cloud.has_colors) {
-    header << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-    record += 3;
-  }
-  if (cloud.has_scores) {
-    header << "property float scalar_score\n";
-    record += 4;
-  }
-  if (cloud.has_views) {
-    header << "property " << (views_fit_uchar ? "uchar" : "int") << " scalar_views\n";
-    record += views_fit_uchar ? 1 : 4;
-  }
-  header << "end_header\n";
-
-  WriteStreamAtomically(path, [&](std::ostream& out) {
-    const std::string text = header.str();
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    std::vector<uint8_t> buffer;
-    for (size_t first = 0; first < cloud.points.size(); first += kPlyChunkPoints) {
-      const size_t n = std::min(kPlyChunkPoints, cloud.points.size() - first);
-      buffer.resize(n * record);
-      uint8_t* b = buffer.data();
-      auto put = [&b](const void* v, size_t size) {
-        std::memcpy(b, v, size);
-        b += size;
-      };
-      for (size_t i = first; i < first + n; ++i) {
-        const CloudPoint& p = cloud.points[i];
-        put(p.position.data(), 24);
-        if (cloud.has_normals) put(p.normal.data(), 12);
-        if (cloud.has_colors) put(p.color.data(), 3);
-        if (cloud.has_scores) put(&p.score, 4);
-        if (cloud.has_views) {
-          if (views_fit_uchar) {
-            const uint8_t v = static_cast<uint8_t>(p.num_views);
-            put(&v, 1);
-          } else {
-            const int32_t v = p.num_views;
-            put(&v, 4);
-          }
-        }
-      }
-      out.write(reinterpret_cast<const char*>(buffer.data()),
-                static_cast<std::streamsize>(buffer.size()));
-    }
-  });
 }
 
 }  // namespace sapmvs

@@ -17,9 +17,10 @@ namespace sapmvs {
 
 std::string DsmOptions::Problem() const { return FirstRangeProblem(*this); }
 
-double MeanPointSpacing(const PointCloud& cloud, size_t max_samples) {
+SpacingSum SumPointSpacing(const PointCloud& cloud, size_t stride) {
+  SpacingSum sum;
   const size_t n = cloud.points.size();
-  if (n < 2) return 0;
+  if (n < 2) return sum;
   // Relative to the first point: UTM coordinates leave no digits to spare.
   const Eigen::Vector3d o = cloud.points.front().position;
   std::vector<double> xyz(3 * n);
@@ -32,9 +33,8 @@ double MeanPointSpacing(const PointCloud& cloud, size_t max_samples) {
   flann::Index<flann::L2<double>> index(flann::Matrix<double>(xyz.data(), n, 3),
                                         flann::KDTreeSingleIndexParams(10));
   index.buildIndex();
-  const size_t stride = std::max<size_t>(1, n / std::max<size_t>(1, max_samples));
   std::vector<double> queries;
-  for (size_t i = 0; i < n; i += stride)
+  for (size_t i = 0; i < n; i += std::max<size_t>(1, stride))
     queries.insert(queries.end(), &xyz[3 * i], &xyz[3 * i + 3]);
   const size_t m = queries.size() / 3;
   std::vector<size_t> idx(2 * m);
@@ -43,9 +43,17 @@ double MeanPointSpacing(const PointCloud& cloud, size_t max_samples) {
   flann::Matrix<double> d2_m(d2.data(), m, 2);
   index.knnSearch(flann::Matrix<double>(queries.data(), m, 3), idx_m, d2_m, 2,
                   flann::SearchParams(flann::FLANN_CHECKS_UNLIMITED));
-  double sum = 0;
-  for (size_t q = 0; q < m; ++q) sum += std::sqrt(d2[2 * q + 1]);  // [0] is the point itself
-  return sum / static_cast<double>(m);
+  for (size_t q = 0; q < m; ++q) sum.sum += std::sqrt(d2[2 * q + 1]);  // [0] is the point itself
+  sum.samples = static_cast<long>(m);
+  return sum;
+}
+
+double MeanPointSpacing(const PointCloud& cloud, size_t max_samples) {
+  const size_t n = cloud.points.size();
+  if (n < 2) return 0;
+  const SpacingSum s =
+      SumPointSpacing(cloud, std::max<size_t>(1, n / std::max<size_t>(1, max_samples)));
+  return s.sum / static_cast<double>(s.samples);
 }
 
 namespace {
@@ -89,22 +97,24 @@ CloudFootprint MeasureFootprint(const PointCloud& cloud, double cell_size) {
   return f;
 }
 
-GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options, double* cell_size_used) {
+double DsmCellSize(const DsmOptions& options, double mean_spacing) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("dsm: expected " + problem);
-  if (cloud.points.empty()) throw Error("dsm: the cloud has no points");
-  double cell = options.cell_size;
-  if (cell == 0) cell = 2 * MeanPointSpacing(cloud);
+  const double cell = options.cell_size == 0 ? 2 * mean_spacing : options.cell_size;
   if (!(cell > 0)) throw Error("dsm: the points coincide; give a cell size (--dsm-cell)");
-  const Extent e = CloudExtent(cloud);
+  return cell;
+}
+
+GeoRaster EmptyDsm(double xmin, double ymin, double xmax, double ymax, double cell,
+                   const std::string& crs) {
   GeoRaster r;
   // Whole cells from a multiple of the cell size, so that rasters of
   // neighbouring runs line up.
-  r.origin_x = std::floor(e.xmin / cell) * cell;
-  r.origin_y = std::ceil(e.ymax / cell) * cell;
-  if (r.origin_y == e.ymax) r.origin_y += cell;
-  const double w = std::floor((e.xmax - r.origin_x) / cell) + 1;
-  const double h = std::floor((r.origin_y - e.ymin) / cell) + 1;
+  r.origin_x = std::floor(xmin / cell) * cell;
+  r.origin_y = std::ceil(ymax / cell) * cell;
+  if (r.origin_y == ymax) r.origin_y += cell;
+  const double w = std::floor((xmax - r.origin_x) / cell) + 1;
+  const double h = std::floor((r.origin_y - ymin) / cell) + 1;
   if (w * h > static_cast<double>(1 << 28)) {
     std::ostringstream s;
     s << "dsm: a cell of " << cell << " gives " << w << " x " << h
@@ -114,23 +124,26 @@ GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options, doubl
   r.width = static_cast<int>(w);
   r.height = static_cast<int>(h);
   r.cell_size = cell;
-  r.crs = cloud.crs;
+  r.crs = crs;
   r.values.assign(static_cast<size_t>(r.width) * r.height, std::numeric_limits<float>::quiet_NaN());
-  std::vector<std::vector<float>> heights(r.values.size());
-  for (const CloudPoint& p : cloud.points) {
-    const int c =
-        std::clamp(static_cast<int>((p.position.x() - r.origin_x) / cell), 0, r.width - 1);
-    const int row =
-        std::clamp(static_cast<int>((r.origin_y - p.position.y()) / cell), 0, r.height - 1);
-    heights[static_cast<size_t>(row) * r.width + c].push_back(static_cast<float>(p.position.z()));
-  }
-  for (size_t i = 0; i < heights.size(); ++i) {
-    auto& v = heights[i];
-    if (v.empty()) continue;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    r.values[i] = v[v.size() / 2];
-  }
-  for (int pass = 0; pass < options.fill_passes; ++pass) {
+  return r;
+}
+
+size_t RasterCellIndex(const GeoRaster& r, double x, double y) {
+  const int c = std::clamp(static_cast<int>((x - r.origin_x) / r.cell_size), 0, r.width - 1);
+  const int row = std::clamp(static_cast<int>((r.origin_y - y) / r.cell_size), 0, r.height - 1);
+  return static_cast<size_t>(row) * r.width + c;
+}
+
+float MedianHeight(std::vector<float>* heights) {
+  auto& v = *heights;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+void FillDsmGaps(GeoRaster* dsm, int passes) {
+  GeoRaster& r = *dsm;
+  for (int pass = 0; pass < passes; ++pass) {
     std::vector<float> next = r.values;
     for (int row = 0; row < r.height; ++row) {
       for (int c = 0; c < r.width; ++c) {
@@ -155,6 +168,25 @@ GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options, doubl
     }
     r.values.swap(next);
   }
+}
+
+GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options, double* cell_size_used) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("dsm: expected " + problem);
+  if (cloud.points.empty()) throw Error("dsm: the cloud has no points");
+  const double cell =
+      DsmCellSize(options, options.cell_size == 0 ? MeanPointSpacing(cloud) : options.cell_size);
+  const Extent e = CloudExtent(cloud);
+  GeoRaster r = EmptyDsm(e.xmin, e.ymin, e.xmax, e.ymax, cell, cloud.crs);
+  std::vector<std::vector<float>> heights(r.values.size());
+  for (const CloudPoint& p : cloud.points) {
+    heights[RasterCellIndex(r, p.position.x(), p.position.y())].push_back(
+        static_cast<float>(p.position.z()));
+  }
+  for (size_t i = 0; i < heights.size(); ++i) {
+    if (!heights[i].empty()) r.values[i] = MedianHeight(&heights[i]);
+  }
+  FillDsmGaps(&r, options.fill_passes);
   if (cell_size_used) *cell_size_used = cell;
   return r;
 }

@@ -17,6 +17,13 @@ std::string MergeOptions::Problem() const {
     s << "a merge radius finite and > 0 (radius = " << radius << ")";
     return s.str();
   }
+  if (tile_points < 1000)
+    return "merge tile points >= 1000 (tile_points = " + std::to_string(tile_points) + ")";
+  if (!(std::isfinite(halo_radii) && halo_radii >= 1)) {
+    std::ostringstream s;
+    s << "a merge halo >= 1 radius (halo_radii = " << halo_radii << ")";
+    return s.str();
+  }
   return "";
 }
 
@@ -99,8 +106,8 @@ struct Ref {
 
 }  // namespace
 
-PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOptions& options,
-                            MergeStats* stats) {
+std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
+                                      const MergeOptions& options, MergeStats* stats) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("merge: expected " + problem);
   MergeStats local;
@@ -108,17 +115,11 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
   st = MergeStats{};
   st.kept_by_group.assign(groups.size(), 0);
   st.core_by_group.assign(groups.size(), 0);
-  PointCloud out;
-  if (groups.empty()) return out;
+  std::vector<MergedRef> order;
+  if (groups.empty()) return order;
   for (const GroupCloud& g : groups) {
     if (!g.cloud) throw Error("merge: a group has no cloud");
   }
-  const PointCloud& first = *groups.front().cloud;
-  out.crs = first.crs;
-  out.has_normals = first.has_normals;
-  out.has_colors = first.has_colors;
-  out.has_scores = first.has_scores;
-  out.has_views = first.has_views;
 
   std::vector<Eigen::Vector2d> centers;
   for (const GroupCloud& g : groups) centers.push_back(g.center);
@@ -148,7 +149,6 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
     return groups[ref.group].cloud->points[ref.index];
   };
   RadiusGrid<Ref> kept(options.radius);
-  std::vector<Ref> order;
   for (const Item& item : items) {
     const Eigen::Vector3d& p = point(item.ref).position;
     const bool duplicate = kept.AnyNear(p, [&](const Ref& other) {
@@ -159,18 +159,33 @@ PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOp
       continue;
     }
     kept.Insert(p, item.ref);
-    order.push_back(item.ref);
+    order.push_back({item.ref.group, item.ref.index, item.core});
     ++st.kept_by_group[item.ref.group];
     if (item.core) ++st.core_by_group[item.ref.group];
   }
   // Output in group order, each group's points in their original order, so
   // that the merged file does not depend on score ties.
-  std::sort(order.begin(), order.end(), [](const Ref& a, const Ref& b) {
+  std::sort(order.begin(), order.end(), [](const MergedRef& a, const MergedRef& b) {
     return a.group != b.group ? a.group < b.group : a.index < b.index;
   });
+  st.kept = static_cast<long>(order.size());
+  return order;
+}
+
+PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOptions& options,
+                            MergeStats* stats) {
+  const std::vector<MergedRef> order = MergeGroupRefs(groups, options, stats);
+  PointCloud out;
+  if (groups.empty()) return out;
+  const PointCloud& first = *groups.front().cloud;
+  out.crs = first.crs;
+  out.has_normals = first.has_normals;
+  out.has_colors = first.has_colors;
+  out.has_scores = first.has_scores;
+  out.has_views = first.has_views;
   out.points.reserve(order.size());
-  for (const Ref& ref : order) out.points.push_back(point(ref));
-  st.kept = static_cast<long>(out.points.size());
+  for (const MergedRef& ref : order)
+    out.points.push_back(groups[ref.group].cloud->points[ref.index]);
   return out;
 }
 

@@ -16,6 +16,7 @@
 #include "match/device_spec.h"
 #include "match/patch_kernels.h"
 #include "run/group_dispatch.h"
+#include "run/merged_outputs.h"
 #include "run/mpi_session.h"
 #include "run/run_checkpoint.h"
 #include "run/run_report.h"
@@ -246,47 +247,22 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     return report;  // resumable
   }
 
-  // Merge from the checkpoints, fresh or resumed alike.
-  std::vector<PointCloud> clouds(n);
-  std::vector<GroupCloud> parts(n);
+  // Merge from the checkpoints, fresh or resumed alike, tile by tile.
+  MergedOutputsJob job;
   for (int g = 0; g < n; ++g) {
-    clouds[g] = ReadPly(checkpoints.CloudPath(g));
-    parts[g].cloud = &clouds[g];
-    parts[g].center = plan.groups[g].center + block.origin.head<2>();
+    job.groups.push_back({[&checkpoints, g] { return ReadPly(checkpoints.CloudPath(g)); },
+                          plan.groups[g].center + block.origin.head<2>()});
   }
-  MergeOptions mo;
-  mo.radius =
+  job.merge.radius =
       options.merge_radius_gsd * geometry.gsd_median * std::ldexp(1.0, options.matcher.level);
-  PointCloud merged = MergeGroupClouds(parts, mo, &report.merge);
-  if (merged.crs.empty()) merged.crs = block.crs;
-  clouds.clear();
-  end_stage("merge");
-  if (merged.points.empty()) {
-    throw Error(options.block.string() +
-                ": no point survived matching and filtering; nothing "
-                "written (check the orientation, or lower --threshold)");
-  }
-  report.points = static_cast<long>(merged.points.size());
-  report.bounds_min = report.bounds_max = merged.points.front().position;
-  for (const CloudPoint& p : merged.points) {
-    report.bounds_min = report.bounds_min.cwiseMin(p.position);
-    report.bounds_max = report.bounds_max.cwiseMax(p.position);
-  }
-  report.mean_spacing = MeanPointSpacing(merged);
-  const GeoRaster dsm = RasterizeDsm(merged, options.dsm, &report.dsm_cell);
-  const CloudFootprint fp = MeasureFootprint(merged, report.dsm_cell);
-  report.area = fp.area;
-  report.density = fp.density;
-  end_stage("statistics");
-
-  WritePly(options.out / "cloud.ply", merged);
-  LasWriteOptions lo;
-  lo.version = options.las_version;
-  lo.crs = block.crs;
-  WriteCloudLas(options.out / "cloud.las", merged, lo);
-  WriteGeoTiff(options.out / "dsm.tif", dsm);
-  WriteDsmPictures(dsm, options.out / "dsm_color.tif", options.out / "dsm.png");
-  end_stage("write");
+  job.merge.tile_points = options.merge_tile_points;
+  job.dsm = options.dsm;
+  job.las.version = options.las_version;
+  job.las.crs = block.crs;
+  job.crs = block.crs;
+  job.out = options.out;
+  job.block = options.block;
+  WriteMergedOutputs(job, &report, end_stage);
   report.finished = true;
   report.total_seconds = Since(start);
   report.peak_rss_bytes = ProcessPeakRssBytes();
@@ -375,7 +351,9 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
     return;
   }
   out << "merge         " << report.merge.input << " -> " << report.points << " points ("
-      << report.merge.duplicates << " cross-group duplicates dropped)\n";
+      << report.merge.duplicates << " cross-group duplicates dropped"
+      << (report.merge_tiles > 1 ? ", " + std::to_string(report.merge_tiles) + " tiles" : "")
+      << ")\n";
   out << "\n";
   out << "images  points      run time  avg. distance  density (pts/unit^2)\n";
   out << std::left << std::setw(8) << report.images << std::setw(12) << report.points

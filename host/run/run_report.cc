@@ -154,7 +154,8 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["groups"] = groups;
   j["merge"] = {{"input", report.merge.input},
                 {"kept", report.merge.kept},
-                {"cross_group_duplicates", report.merge.duplicates}};
+                {"cross_group_duplicates", report.merge.duplicates},
+                {"tiles", report.merge_tiles}};
   // Matching stages (summed over the groups matched in this call, with their
   // device time), then the run's own: plan, match (all groups), merge, ...
   nlohmann::json matching = MatchStatsJson(report.stats, options.profile);

@@ -116,6 +116,31 @@ const std::vector<Preset>& AllPresets() {
       c.unit = AngleUnit::kGon;  // like the Vaihingen orientations
       p.push_back(c);
     }
+    {
+      // A block big enough to show how a run scales (1,000 images, 180
+      // groups) at an image size that keeps it within minutes on 2 cores:
+      // tiny's camera and flight at half the resolution. The scene raster
+      // grows with the ground (about 2.8 x 1.8 km); one cell per GSD keeps
+      // it near 18 M cells (about 210 MB with the truth rasters) where tiny's half
+      // GSD would take four times that.
+      Preset l;
+      l.name = "large";
+      l.description =
+          "20 strips x 50 images (1,000) of 320x240 at 120 m, 70 % forward and 35 % side "
+          "overlap; for scaling runs (--strips and --strip-images fly a part of it)";
+      l.camera = {8.8, 40.0, 320, 240};
+      l.flight = {std::vector<int>(20, 50), 120, 0.7, 0.35, 1.5, 0.03};
+      l.scene.relief = 8;
+      l.scene.relief_wavelength = 600;
+      l.scene.road_spacing = 90;
+      l.scene.squares = 12;
+      l.scene.high_rises = 6;
+      l.scene.water_share = 0.015;
+      l.cell_per_gsd = 1.0;
+      l.order = AngleOrder::kOmegaPhiKappa;
+      l.unit = AngleUnit::kDegree;
+      p.push_back(l);
+    }
     return p;
   }();
   return presets;

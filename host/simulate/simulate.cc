@@ -147,6 +147,14 @@ std::string SimulateOptions::Problem() const {
       return "--overlap side " + Number(overlap[1]) + " % is outside [0, 90]";
     }
   }
+  // A strip needs two images to overlap; beyond 10,000 images the scene
+  // raster alone outgrows a workstation.
+  if (strips < 0 || strips > 500)
+    return "--strips " + std::to_string(strips) + " is outside 0..500";
+  if (strip_images < 0 || strip_images > 1000) {
+    return "--strip-images " + std::to_string(strip_images) + " is outside 0..1000";
+  }
+  if (strip_images == 1) return "--strip-images 1: expected at least 2 images per strip";
   return "";
 }
 
@@ -157,6 +165,13 @@ sim::FlightPlan PlanSimulatedFlight(const SimulateOptions& o) {
   if (!o.overlap.empty()) {
     preset.flight.forward_overlap = o.overlap[0] / 100;
     preset.flight.side_overlap = o.overlap[1] / 100;
+  }
+  if (o.strips > 0 || o.strip_images > 0) {
+    std::vector<int>& runs = preset.flight.images_per_strip;
+    const int count = o.strips > 0 ? o.strips : static_cast<int>(runs.size());
+    const int each =
+        o.strip_images > 0 ? o.strip_images : *std::max_element(runs.begin(), runs.end());
+    runs.assign(count, each);
   }
   const double exposure = o.exposure >= 0 ? o.exposure : preset.flight.exposure;
   return sim::PlanFlight(preset, sim::ScaledCamera(preset.camera, o.scale), o.cross_strip, exposure,

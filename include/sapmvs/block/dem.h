@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <limits>
 #include <vector>
 
 namespace sapmvs {
@@ -31,6 +32,10 @@ class Dem {
   int width_ = 0, height_ = 0;
   double geo_[6] = {0, 1, 0, 0, 0, -1};  // GDAL geotransform
   std::vector<float> z_;                 // row-major, NaN = nodata
+  // The lowest and highest height, found once at Load: Intersect bounds its
+  // march by them, and scanning the raster per ray made a block's footprints
+  // cost images x cells (1,000 images on a 5,000 x 3,400 DEM: minutes).
+  double zmin_ = std::numeric_limits<double>::quiet_NaN(), zmax_ = zmin_;
 };
 
 }  // namespace sapmvs

@@ -9,6 +9,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -85,6 +87,46 @@ struct LasWriteOptions {
 // its field's type cannot) before anything is written.
 void WriteLas(const std::filesystem::path& path, const std::vector<PointRecord>& points,
               const LasWriteOptions& options = {}, const std::vector<LasExtraField>& extras = {});
+
+// A cloud written as LAS in chunks, for clouds that never lie in memory
+// whole (a large block's merge, run/tiled_merge.h). The header holds the
+// count, the extent and the quantization chosen from it, and the Extra Bytes
+// descriptors the ranges of the float fields, so the points are seen twice:
+// once to fill a LasCounts and the ranges, once to write them. WriteLas is
+// both passes over one vector, so the two give the same bytes.
+struct LasCounts {
+  size_t count = 0;
+  std::array<double, 3> lo{{kInf, kInf, kInf}}, hi{{-kInf, -kInf, -kInf}};  // x y z as given
+  std::array<uint64_t, 15> by_return{};  // points by return number 1-15
+  // Counts `p` as point number `count`. Throws sapmvs::Error naming `path`
+  // and the point for what `version` cannot store (a non-finite coordinate,
+  // a return number or class too large).
+  void Add(const std::filesystem::path& path, const PointRecord& p, LasVersion version);
+
+ private:
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+};
+
+// Adds `chunk` (extra fields of `points` points) to `ranges`: the same fields
+// with each one's values reduced to its least and greatest so far, all that
+// their descriptors record. Throws sapmvs::Error naming `path` and the value
+// when a value does not fit its type.
+void WidenExtraRanges(const std::filesystem::path& path, const std::vector<LasExtraField>& chunk,
+                      size_t points, std::vector<LasExtraField>* ranges);
+
+// Points the caller holds until the next call, with one value per point in
+// each of the extra fields (those of the ranges, in their order); false at
+// the end.
+using NextLasPoints = std::function<bool(const std::vector<PointRecord>** points,
+                                         const std::vector<LasExtraField>** extras)>;
+
+// Writes the points `next` gives as WriteLas does, atomically, from the
+// first pass's counts and extra-field ranges. Throws sapmvs::Error naming
+// `path` for bad options, more points than LAS 1.2 can count, points that are
+// not `counts.count`, or a failed write; nothing is left then.
+void WriteLasStream(const std::filesystem::path& path, const LasCounts& counts,
+                    const LasWriteOptions& options, const std::vector<LasExtraField>& ranges,
+                    const NextLasPoints& next);
 
 struct LasCloud {
   std::vector<PointRecord> points;

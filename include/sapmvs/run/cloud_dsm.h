@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/io/raster_io.h"
@@ -45,6 +46,15 @@ void VisitFields(DsmOptions& o, F&& f) {
 // stable long before a million). 0 for fewer than 2 points.
 double MeanPointSpacing(const PointCloud& cloud, size_t max_samples = 200000);
 
+// MeanPointSpacing's parts, for a cloud seen in tiles (tiled_merge.h): the
+// summed distances from every `stride`-th point (from the first) to its
+// nearest neighbour, and how many.
+struct SpacingSum {
+  double sum = 0;
+  long samples = 0;
+};
+SpacingSum SumPointSpacing(const PointCloud& cloud, size_t stride);
+
 struct CloudFootprint {
   double cell_size = 0;     // of the occupancy grid, CRS units
   long occupied_cells = 0;  // cells holding at least one point
@@ -59,5 +69,20 @@ CloudFootprint MeasureFootprint(const PointCloud& cloud, double cell_size);
 // raster over 2^28 cells (a cell size far too small for the extent).
 GeoRaster RasterizeDsm(const PointCloud& cloud, const DsmOptions& options,
                        double* cell_size_used = nullptr);
+
+// RasterizeDsm's steps, for a cloud seen in chunks (streamed_dsm.h).
+// The cell side: options.cell_size, or twice `mean_spacing` for 0. Throws
+// sapmvs::Error for bad options or a cell of 0.
+double DsmCellSize(const DsmOptions& options, double mean_spacing);
+// The all-nodata raster covering the points' XY extent. Throws sapmvs::Error
+// beyond 2^28 cells.
+GeoRaster EmptyDsm(double xmin, double ymin, double xmax, double ymax, double cell,
+                   const std::string& crs);
+// The index into `dsm.values` of the cell holding (x, y), clamped to the raster.
+size_t RasterCellIndex(const GeoRaster& dsm, double x, double y);
+// The median of a cell's heights (reorders them; not empty).
+float MedianHeight(std::vector<float>* heights);
+// `passes` passes of gap filling (DsmOptions::fill_passes).
+void FillDsmGaps(GeoRaster* dsm, int passes);
 
 }  // namespace sapmvs

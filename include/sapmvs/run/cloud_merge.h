@@ -27,6 +27,12 @@ struct MergeOptions {
   // Duplicate distance, CRS units (> 0): the caller passes about one ground
   // sample distance of the level matched, the spacing of the emitted points.
   double radius = 0;
+  // The tiled merge (tiled_merge.h): about this many group points per tile;
+  // a block with no more than these is merged in one piece (>= 1000).
+  long tile_points = 250000;  // RunOptions::merge_tile_points gives it
+  // The tiled merge's halo: each tile is merged with the points within this
+  // many radii around it, and keeps only its own (>= 1).
+  double halo_radii = 8;
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
 };
@@ -44,6 +50,20 @@ struct MergeStats {
 // points in the same order. Throws sapmvs::Error for bad options.
 PointCloud MergeGroupClouds(const std::vector<GroupCloud>& groups, const MergeOptions& options,
                             MergeStats* stats = nullptr);
+
+// A point the merge keeps: groups[group].cloud->points[index], and whether it
+// lies in its group's core.
+struct MergedRef {
+  int group = 0;
+  size_t index = 0;
+  bool core = false;
+};
+
+// What MergeGroupClouds keeps, in its output order (group, then index). A
+// group's cloud may hold only some of its points (a tile of the block, see
+// tiled_merge.h): every group's centre still takes part in the cores.
+std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
+                                      const MergeOptions& options, MergeStats* stats = nullptr);
 
 // The index of the centre nearest to (x, y): the core owner; -1 for none.
 int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);

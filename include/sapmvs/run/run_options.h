@@ -10,6 +10,7 @@
 #include "sapmvs/match/matcher_options.h"
 #include "sapmvs/plan/grouping_options.h"
 #include "sapmvs/run/cloud_dsm.h"
+#include "sapmvs/run/cloud_merge.h"
 #include "sapmvs/util/option_spec.h"
 
 namespace sapmvs {
@@ -38,6 +39,10 @@ struct RunOptions {
   // Merge: a point is a duplicate of another group's point within this many
   // ground sample distances of the matched level. > 0.
   double merge_radius_gsd = 1.0;
+  // Merge tile by tile, about this many group points a tile, so that the
+  // merge, the DSM and the writers never hold the block's points at once;
+  // a block with fewer is merged whole (tiled_merge.h). >= 1000.
+  int merge_tile_points = 250000;
   DsmOptions dsm;
   // cloud.las: LAS 1.2 by default, which every reader opens (las_io.h).
   LasVersion las_version = LasWriteOptions{}.version;
@@ -81,6 +86,12 @@ void VisitFields(RunOptions& o, F&& f) {
         .Unit("GSDs")
         .Range(Above(0))
         .Help("Merge: duplicate distance, GSDs of the level matched"));
+  f(Field(o.merge_tile_points, "merge_tile_points")
+        .Flag("--merge-tile-points")
+        .In("Merge and DSM")
+        .Unit("points")
+        .Range(AtLeast(1000))
+        .Help("Merge: group points per tile (a block with fewer is merged whole)"));
   f(Field(o.las_version, "las_version")
         .Flag("--las-version")
         .In("Merge and DSM")

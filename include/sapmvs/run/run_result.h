@@ -65,6 +65,7 @@ struct RunReport {
   std::vector<std::string> ungrouped;  // images the plan put in no group (grouping.h)
   MatchStats stats;                    // summed over the groups matched in this call
   MergeStats merge;
+  int merge_tiles = 0;  // tiles the merge was cut into (tiled_merge.h)
   long points = 0;
   double mean_spacing = 0;  // mean nearest-neighbour distance, CRS units
   double density = 0;       // points per CRS unit squared of covered ground

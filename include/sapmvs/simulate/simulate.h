@@ -18,7 +18,7 @@
 namespace sapmvs {
 
 struct SimulateOptions {
-  std::string preset = "tiny";  // tiny | small | campus | mountain | city
+  std::string preset = "tiny";  // tiny | small | campus | mountain | city | large
   std::filesystem::path out;    // output folder, created when missing
   uint64_t seed = 1;            // same seed, same bytes
   double scale = 1.0;  // image resolution factor: 0.5 halves width and height, doubles the GSD
@@ -29,6 +29,11 @@ struct SimulateOptions {
   // (e.g. {88, 30}); empty = the preset's. The base is (1 - forward) x the
   // along-track footprint, the strip spacing (1 - side) x the across-track one.
   std::vector<double> overlap;
+  // The flight's strips and images per strip, 0 = the preset's (its strip
+  // count; its longest strip). Either one replaces the preset's uneven strips
+  // by equal ones: the same flight, cut shorter or narrower, for scaling runs.
+  int strips = 0;
+  int strip_images = 0;
   double exposure = -1;   // largest relative exposure change between images; < 0 = the preset's
   int supersampling = 2;  // rays per pixel side (2 = 2x2 per pixel), at least 2
   double noise = 1.5;     // sensor noise, standard deviation in 8-bit grey levels

@@ -1,0 +1,147 @@
+#include "sapmvs/run/tiled_merge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+namespace {
+
+struct Box {
+  double xmin = std::numeric_limits<double>::infinity(), ymin = xmin;
+  double xmax = -xmin, ymax = -xmin;
+  bool empty() const { return !(xmin <= xmax); }
+  void Add(double x, double y) {
+    xmin = std::min(xmin, x);
+    xmax = std::max(xmax, x);
+    ymin = std::min(ymin, y);
+    ymax = std::max(ymax, y);
+  }
+  bool Meets(const Box& o) const {
+    return !empty() && !o.empty() && xmin <= o.xmax && o.xmin <= xmax && ymin <= o.ymax &&
+           o.ymin <= ymax;
+  }
+  bool Holds(double x, double y) const { return x >= xmin && x <= xmax && y >= ymin && y <= ymax; }
+};
+
+PointCloud FormatOf(const PointCloud& c) {
+  PointCloud f;
+  f.crs = c.crs;
+  f.has_normals = c.has_normals;
+  f.has_colors = c.has_colors;
+  f.has_scores = c.has_scores;
+  f.has_views = c.has_views;
+  return f;
+}
+
+// The tile a point belongs to: clamped, so that the extent's far edges
+// belong to the last tiles.
+int TileOf(double v, double origin, double side, int tiles) {
+  if (tiles <= 1) return 0;
+  return std::clamp(static_cast<int>(std::floor((v - origin) / side)), 0, tiles - 1);
+}
+
+}  // namespace
+
+MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptions& options,
+                        const MergedTile& emit, MergeLayout* layout_out) {
+  const std::string problem = options.Problem();
+  if (!problem.empty()) throw Error("merge: expected " + problem);
+  const size_t n = groups.size();
+  MergeStats st;
+  st.kept_by_group.assign(n, 0);
+  st.core_by_group.assign(n, 0);
+  MergeLayout layout;
+  // First pass: each group's extent, one group in memory at a time.
+  std::vector<Box> extent(n);
+  Box block;
+  for (size_t g = 0; g < n; ++g) {
+    const PointCloud c = groups[g].load();
+    if (g == 0) layout.format = FormatOf(c);
+    for (const CloudPoint& p : c.points) extent[g].Add(p.position.x(), p.position.y());
+    layout.input_points += static_cast<long>(c.points.size());
+    if (!extent[g].empty()) {
+      block.Add(extent[g].xmin, extent[g].ymin);
+      block.Add(extent[g].xmax, extent[g].ymax);
+    }
+  }
+  if (layout.input_points == 0) {
+    if (layout_out) *layout_out = layout;
+    return st;
+  }
+  const double halo = options.halo_radii * options.radius;
+  layout.tiles_x = layout.tiles_y = 1;
+  if (layout.input_points > options.tile_points) {
+    // Square tiles of about tile_points each at the block's mean density,
+    // and at least four halos wide, so that the halos cost at most about
+    // twice the tile's own points.
+    const double w = std::max(block.xmax - block.xmin, options.radius);
+    const double h = std::max(block.ymax - block.ymin, options.radius);
+    const double share = static_cast<double>(options.tile_points) / layout.input_points;
+    layout.tile_side = std::max(std::sqrt(w * h * share), 4 * halo);
+    layout.tiles_x = std::max(1, static_cast<int>(std::ceil(w / layout.tile_side)));
+    layout.tiles_y = std::max(1, static_cast<int>(std::ceil(h / layout.tile_side)));
+    if (layout.tiles() == 1) layout.tile_side = 0;
+  }
+  if (layout_out) *layout_out = layout;
+  const bool whole = layout.tiles() == 1;
+
+  std::vector<PointCloud> clouds(n);
+  std::vector<GroupCloud> parts(n);
+  for (size_t g = 0; g < n; ++g) {
+    parts[g].cloud = &clouds[g];
+    parts[g].center = groups[g].center;
+  }
+  for (int ty = 0; ty < layout.tiles_y; ++ty) {
+    for (int tx = 0; tx < layout.tiles_x; ++tx) {
+      Box reach = block;  // the tile and its halo
+      if (!whole) {
+        reach.xmin = block.xmin + tx * layout.tile_side - halo;
+        reach.xmax = block.xmin + (tx + 1) * layout.tile_side + halo;
+        reach.ymin = block.ymin + ty * layout.tile_side - halo;
+        reach.ymax = block.ymin + (ty + 1) * layout.tile_side + halo;
+      }
+      auto own = [&](const CloudPoint& p) {
+        return whole ||
+               (TileOf(p.position.x(), block.xmin, layout.tile_side, layout.tiles_x) == tx &&
+                TileOf(p.position.y(), block.ymin, layout.tile_side, layout.tiles_y) == ty);
+      };
+      for (size_t g = 0; g < n; ++g) {
+        clouds[g] = PointCloud{};
+        if (!extent[g].Meets(reach)) continue;
+        clouds[g] = groups[g].load();
+        if (whole) continue;
+        auto& pts = clouds[g].points;
+        pts.erase(std::remove_if(pts.begin(), pts.end(),
+                                 [&](const CloudPoint& p) {
+                                   return !reach.Holds(p.position.x(), p.position.y());
+                                 }),
+                  pts.end());
+        pts.shrink_to_fit();  // the tile holds its share of the group, not the whole
+      }
+      MergeStats tile_stats;
+      const std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats);
+      PointCloud tile = layout.format;
+      for (const MergedRef& ref : refs) {
+        const CloudPoint& p = clouds[ref.group].points[ref.index];
+        if (!own(p)) continue;
+        tile.points.push_back(p);
+        ++st.kept_by_group[ref.group];
+        if (ref.core) ++st.core_by_group[ref.group];
+      }
+      long input = 0;
+      for (const PointCloud& c : clouds) {
+        for (const CloudPoint& p : c.points) input += own(p);
+      }
+      st.input += input;
+      st.kept += static_cast<long>(tile.points.size());
+      st.duplicates += input - static_cast<long>(tile.points.size());
+      if (!tile.points.empty()) emit(tile, layout);
+    }
+  }
+  return st;
+}
+
+}  // namespace sapmvs
