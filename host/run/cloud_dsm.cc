@@ -85,11 +85,14 @@ CloudFootprint MeasureFootprint(const PointCloud& cloud, double cell_size) {
   f.cell_size = cell_size;
   if (cloud.points.empty()) return f;
   const Eigen::Vector3d o = cloud.points.front().position;
-  std::unordered_map<long long, char> cells;
+  std::unordered_map<unsigned long long, char> cells;
   for (const CloudPoint& p : cloud.points) {
     const long long cx = static_cast<long long>(std::floor((p.position.x() - o.x()) / cell_size));
     const long long cy = static_cast<long long>(std::floor((p.position.y() - o.y()) / cell_size));
-    cells[(cx << 32) ^ (cy & 0xffffffffLL)] = 1;
+    // Unsigned: a cell west of the first point has cx < 0, and shifting a
+    // negative value is undefined (UBSan, TiledMergeTest).
+    cells[(static_cast<unsigned long long>(cx) << 32) ^
+          (static_cast<unsigned long long>(cy) & 0xffffffffULL)] = 1;
   }
   f.occupied_cells = static_cast<long>(cells.size());
   f.area = static_cast<double>(f.occupied_cells) * cell_size * cell_size;
