@@ -84,6 +84,15 @@ std::string GroupNames(const Block& block, const std::vector<int>& ids) {
   return ids.size() > 4 ? s + ", ..." : s;
 }
 
+// A group's estimate with the process around it (PlanGroups' process_bytes),
+// which is what memory_budget bounds.
+GroupMemory EstimateInProcess(const Block& block, const std::vector<int>& ids,
+                              const MatcherOptions& matcher, double process_bytes) {
+  GroupMemory mem = EstimateGroupMemory(block, ids, matcher);
+  mem.process_bytes = process_bytes;
+  return mem;
+}
+
 // Throws when the smallest group that can be matched does not fit: the
 // min_image_num (at least 2) largest images, as a point needs that many
 // views. Every other group of that size then fits too, as the estimate grows
@@ -99,8 +108,7 @@ void CheckSmallestGroupFits(const Block& block, const GroupingOptions& o, const 
            static_cast<double>(cb.width()) * cb.height();
   });
   ids.resize(k);
-  GroupMemory mem = EstimateGroupMemory(block, ids, m);
-  mem.process_bytes = process_bytes;
+  const GroupMemory mem = EstimateInProcess(block, ids, m, process_bytes);
   if (mem.Total() > o.memory_budget) {
     throw Error(
         "memory budget " + FormatBytes(o.memory_budget) + " is too small: " + std::to_string(k) +
@@ -116,7 +124,7 @@ void CheckSmallestGroupFits(const Block& block, const GroupingOptions& o, const 
 
 // The plan's options and matcher say what a group may use.
 bool Fits(const Block& block, const std::vector<int>& ids, const GroupingPlan& plan) {
-  return EstimateGroupMemory(block, ids, plan.matcher).Total() + plan.process_bytes <=
+  return EstimateInProcess(block, ids, plan.matcher, plan.process_bytes).Total() <=
          plan.options.memory_budget;
 }
 
@@ -494,8 +502,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   ImageGroup all;
   all.images.resize(block.images.size());
   std::iota(all.images.begin(), all.images.end(), 0);
-  all.memory = EstimateGroupMemory(block, all.images, matcher);
-  all.memory.process_bytes = process_bytes;
+  all.memory = EstimateInProcess(block, all.images, matcher, process_bytes);
   if (static_cast<int>(all.images.size()) <= options.max_images &&
       all.memory.Total() <= options.memory_budget) {
     for (const int i : all.images) all.center += fp[i].center;
@@ -507,8 +514,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     return plan;
   }
   for (ImageGroup& g : plan.groups) {
-    g.memory = EstimateGroupMemory(block, g.images, matcher);
-    g.memory.process_bytes = process_bytes;
+    g.memory = EstimateInProcess(block, g.images, matcher, process_bytes);
     g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num);
   }
   return plan;

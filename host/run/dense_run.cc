@@ -99,6 +99,14 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   sum->gsd = s.gsd;
 }
 
+// A group finished by an earlier call or another rank, as its checkpoint
+// records it.
+void TakeCheckpoint(const GroupCheckpoint& c, GroupRun* run) {
+  run->points = c.points;
+  run->seconds = c.seconds;
+  run->memory = c.memory;
+}
+
 RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   dispatch.Start();
   const std::string problem = options.Problem();
@@ -186,10 +194,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     run.memory_estimate_bytes = plan.groups[g].memory.Total();
     for (const int i : plan.groups[g].images) run.images.push_back(block.images[i].name);
     if (checkpoints.Done(g)) {
-      const GroupCheckpoint c = checkpoints.Read(g);
-      run.points = c.points;
-      run.seconds = c.seconds;
-      run.memory = c.memory;
+      TakeCheckpoint(checkpoints.Read(g), &run);
       run.resumed = true;
       report.groups.push_back(run);
       continue;
@@ -216,7 +221,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     run.points = static_cast<long>(result.cloud.points.size());
     run.memory.peak_rss_bytes = PeakRssBytes();
     run.memory.peak_device_bytes = kernels->PeakDeviceBytes();
-    progress.EndGroup(run.points, run.memory.peak_rss_bytes, plan.groups[g].memory.Total());
+    progress.EndGroup(run.points, run.memory.peak_rss_bytes, run.memory_estimate_bytes);
     AddStats(result.stats, &report.stats);
     for (const auto& [name, t] : result.stats.stages) {
       LogDetail("group " + std::to_string(g + 1) + "/" + std::to_string(n) + ": " + name + " " +
@@ -235,10 +240,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   for (GroupRun& run : report.groups) {
     run.rank = report.ranks > 1 ? matched_by[run.index] : -1;
     if (run.rank <= 0 || !checkpoints.Done(run.index)) continue;
-    const GroupCheckpoint c = checkpoints.Read(run.index);  // matched by another rank
-    run.points = c.points;
-    run.seconds = c.seconds;
-    run.memory = c.memory;
+    TakeCheckpoint(checkpoints.Read(run.index), &run);  // matched by another rank
   }
   for (int g = 0; g < n; ++g) stopped = stopped || !checkpoints.Done(g);
   if (stopped) {

@@ -27,6 +27,9 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
   LasCounts las_counts;
   std::vector<LasExtraField> las_ranges;
   SpacingSum spacing;
+  // The first merged point (the footprint's grid origin, as MeasureFootprint
+  // takes it) and the bounds.
+  Eigen::Vector3d first = Eigen::Vector3d::Zero();
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
   MergeLayout layout;
   report->merge = MergeInTiles(
@@ -35,7 +38,7 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
         if (spill.size() == 0) {
           format = l.format;
           if (format.crs.empty()) format.crs = job.crs;
-          lo = hi = tile.points.front().position;
+          first = lo = hi = tile.points.front().position;
         }
         for (const CloudPoint& p : tile.points) {
           ply_counts.Add(ply.string(), p, format.has_views);
@@ -70,11 +73,9 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
   report->mean_spacing = spacing.samples > 0 ? spacing.sum / spacing.samples : 0;
 
   const double cell = DsmCellSize(job.dsm, report->mean_spacing);
-  NextPoints next = spill.Read();
-  const Eigen::Vector3d first = next().data->position;
   StreamedDsm dsm_bands(first, lo.x(), lo.y(), hi.x(), hi.y(), cell, format.crs, report->points,
                         job.out);
-  next = spill.Read();
+  NextPoints next = spill.Read();
   for (PointSpan s = next(); s.size > 0; s = next()) dsm_bands.Add(s);
   const CloudFootprint fp = dsm_bands.Footprint();
   const GeoRaster dsm = dsm_bands.Finish(job.dsm.fill_passes);

@@ -54,17 +54,27 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
   st.kept_by_group.assign(n, 0);
   st.core_by_group.assign(n, 0);
   MergeLayout layout;
-  // First pass: each group's extent, one group in memory at a time.
+  // First pass: each group's extent. The clouds are kept while they hold at
+  // most tile_points in all, so that a block merged whole reads each group
+  // once; past that, one group is in memory at a time.
   std::vector<Box> extent(n);
   Box block;
+  std::vector<PointCloud> read(n);
+  bool all_read = true;
   for (size_t g = 0; g < n; ++g) {
-    const PointCloud c = groups[g].load();
+    PointCloud c = groups[g].load();
     if (g == 0) layout.format = FormatOf(c);
     for (const CloudPoint& p : c.points) extent[g].Add(p.position.x(), p.position.y());
     layout.input_points += static_cast<long>(c.points.size());
     if (!extent[g].empty()) {
       block.Add(extent[g].xmin, extent[g].ymin);
       block.Add(extent[g].xmax, extent[g].ymax);
+    }
+    if (all_read && layout.input_points <= options.tile_points) {
+      read[g] = std::move(c);
+    } else if (all_read) {
+      all_read = false;
+      read = std::vector<PointCloud>(n);
     }
   }
   if (layout.input_points == 0) {
@@ -111,7 +121,7 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
       for (size_t g = 0; g < n; ++g) {
         clouds[g] = PointCloud{};
         if (!extent[g].Meets(reach)) continue;
-        clouds[g] = groups[g].load();
+        clouds[g] = whole && all_read ? std::move(read[g]) : groups[g].load();
         if (whole) continue;
         auto& pts = clouds[g].points;
         pts.erase(std::remove_if(pts.begin(), pts.end(),
