@@ -11,6 +11,7 @@
 //   PATCH_SIZE        μ, samples per side of the patch grid (odd).
 //   NCC_MIN_VARIANCE  smallest per-sample variance of a sample vector.
 //   NCC_SIGMA_COLOR   > 0 weights the NCC samples (ncc_weights); 0 = plain NCC.
+//   SAMPLE_STEP       spacing of the grid's samples, in reference pixels.
 
 #ifndef WORK_GROUP_SIZE
 #define WORK_GROUP_SIZE 64
@@ -47,14 +48,15 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_s
   const float3 c = patch.center.xyz;
   const float3 n = patch.normal.xyz;
 
-  // Grid spacing: the footprint of one reference pixel at c, depth / f (the
-  // third row of K [R | t] gives the depth along the optical axis).
+  // Grid spacing: SAMPLE_STEP footprints of one reference pixel at c,
+  // depth / f (the third row of K [R | t] gives the depth along the optical
+  // axis).
   const float depth = dot(ref.p2, (float4)(c, 1.0f));
   if (!(depth > 0.0f)) {
     scores[i] = NAN;
     return;
   }
-  const float step = depth / ref.center.w;
+  const float step = SAMPLE_STEP * (depth / ref.center.w);
   // In-plane axes: the reference x axis projected onto the plane, and the
   // in-plane perpendicular turned towards the reference y axis, so the grid
   // follows the reference image's rows and columns (as PMVS's getPAxes).
@@ -75,12 +77,14 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_s
   float a[NCC_NUM_SAMPLES];
   float b[NCC_NUM_SAMPLES];
   const int half_size = PATCH_SIZE / 2;
+  const GridProjection ga = project_grid(ref, c, dx, dy);
+  const GridProjection gb = project_grid(view, c, dx, dy);
   for (int r = 0; r < PATCH_SIZE; ++r) {
-    const float3 row = c + (float)(r - half_size) * dy;
+    const float fr = (float)(r - half_size);
     for (int col = 0; col < PATCH_SIZE; ++col) {
-      const float3 X = row + (float)(col - half_size) * dx;
-      const float va = sample_projection(images, image_table, patch.reference, ref, X);
-      const float vb = sample_projection(images, image_table, pair.y, view, X);
+      const float fc = (float)(col - half_size);
+      const float va = sample_grid(images, image_table, patch.reference, ga, fr, fc);
+      const float vb = sample_grid(images, image_table, pair.y, gb, fr, fc);
       // One NaN sample (outside, behind, or a NaN pixel) voids the pair.
       if (isnan(va) || isnan(vb)) {
         scores[i] = NAN;

@@ -7,7 +7,7 @@
 // schedule and tie rules.
 //
 // The NCC primitives (NccCamera, NccPatch, bilinear_at, sample_image,
-// sample_projection, ncc_of, ncc_weights) come from ncc.cl, as in
+// project_grid, sample_grid, ncc_of, ncc_weights) come from ncc.cl, as in
 // ncc_score.cl. The grid geometry of patch_views_ncc is that of the
 // ncc_score kernel body.
 //
@@ -16,6 +16,7 @@
 //   PATCH_SIZE        μ, samples per side of the patch grid (odd).
 //   NCC_MIN_VARIANCE  smallest per-sample variance of a sample vector.
 //   NCC_SIGMA_COLOR   > 0 weights the NCC samples (ncc_weights); 0 = plain NCC.
+//   SAMPLE_STEP       spacing of the grid's samples, in reference pixels.
 //   MAX_VIEWS         most views per patch (bounds the private arrays).
 
 #ifndef WORK_GROUP_SIZE
@@ -30,7 +31,7 @@
 // One refined patch (host: RefinedPatchOut, 48 bytes).
 typedef struct {
   float4 center;  // xyz: refined centre; w: mean NCC over the views (NaN: none valid).
-  float4 normal;  // xyz: refined unit normal; w: 0.
+  float4 normal;  // xyz: refined unit normal; w: candidates scored, the start included.
   float4 params;  // x: depth offset along the ray from the start, in footprints;
                   // y: yaw, z: pitch (radians); w: accepted moves.
 } RefinedPatchOut;
@@ -57,7 +58,7 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
   if (!(depth > 0.0f)) {
     return NAN;
   }
-  const float step = depth / ref.center.w;
+  const float step = SAMPLE_STEP * (depth / ref.center.w);
   const float3 x_proj = ref.x_axis.xyz - dot(ref.x_axis.xyz, n) * n;
   const float x_length = length(x_proj);
   if (!(x_length >= NCC_MIN_AXIS_LENGTH)) {
@@ -74,11 +75,11 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
 
   // The reference samples once, shared by every view.
   float a[NCC_NUM_SAMPLES];
+  const GridProjection ga = project_grid(ref, c, dx, dy);
   for (int r = 0; r < PATCH_SIZE; ++r) {
-    const float3 row = c + (float)(r - half_size) * dy;
     for (int col = 0; col < PATCH_SIZE; ++col) {
-      const float3 X = row + (float)(col - half_size) * dx;
-      const float va = sample_projection(images, table, reference, ref, X);
+      const float va =
+          sample_grid(images, table, reference, ga, (float)(r - half_size), (float)(col - half_size));
       if (isnan(va)) {
         return NAN;
       }
@@ -91,13 +92,12 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
   bool all_valid = true;
   float b[NCC_NUM_SAMPLES];
   for (int v = 0; v < num_views; ++v) {
-    const NccCamera view = cameras[views[v]];
+    const GridProjection gb = project_grid(cameras[views[v]], c, dx, dy);
     bool valid = true;
     for (int r = 0; r < PATCH_SIZE && valid; ++r) {
-      const float3 row = c + (float)(r - half_size) * dy;
       for (int col = 0; col < PATCH_SIZE; ++col) {
-        const float3 X = row + (float)(col - half_size) * dx;
-        const float vb = sample_projection(images, table, views[v], view, X);
+        const float vb = sample_grid(images, table, views[v], gb, (float)(r - half_size),
+                                     (float)(col - half_size));
         if (isnan(vb)) {
           valid = false;
           break;
@@ -125,10 +125,14 @@ bool improves(float score, float best) { return !isnan(score) && (isnan(best) ||
 // Parameters: t (distance from the reference centre along the ray through the
 // initial centre), yaw, pitch (see normal_of). Initial steps: depth_step
 // footprints (depth / f at the initial centre) for t, angle_step radians for
-// both angles. Each of `iterations` rounds scores the 6 candidates
-// p +- step_k e_k (in the order +t, -t, +yaw, -yaw, +pitch, -pitch), moves to
-// the best if it strictly beats the current score, else halves every step;
-// the search ends early after max_halvings halvings (converged).
+// both angles. Each of `iterations` rounds polls the 6 candidates
+// p +- step_k e_k in the order +t, -t, +yaw, -yaw, +pitch, -pitch, starting
+// from the direction that moved last, and moves to the first that strictly
+// beats the current score; when none does it halves every step. The search
+// ends early after max_halvings halvings (converged). Polling instead of
+// scoring all 6 and taking the best: a move costs 1 to 3 scores instead of
+// 6, for the same accuracy (`small`: 32 % less device time, 91.9 % of the
+// points within 1 GSD against 91.8 %; city: 39 %, 76.3 % against 75.3 %).
 // A candidate with |yaw| or |pitch| above max_angle is invalid (NaN).
 __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch_refine(
     __global const float* restrict images, __global const int4* restrict image_table,
@@ -178,7 +182,6 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   float step[3] = {depth_step * footprint, angle_step, angle_step};
   float nccs[MAX_VIEWS];
   float trial[MAX_VIEWS];
-  float best_nccs[MAX_VIEWS];
   float score = NAN;
   if (fabs(p[1]) <= max_angle && fabs(p[2]) <= max_angle) {
     score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
@@ -190,10 +193,12 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   }
   int moves = 0;
   int halvings = 0;
+  int evaluations = 1;
+  int lead = 0;  // the direction that moved last, tried first
   for (int it = 0; it < iterations && halvings < max_halvings; ++it) {
-    float best = score;
-    int best_k = -1;
-    for (int k = 0; k < 6; ++k) {
+    int moved = -1;
+    for (int j = 0; j < 6 && moved < 0; ++j) {
+      const int k = (lead + j) % 6;
       float q[3] = {p[0], p[1], p[2]};
       q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
       if (!(fabs(q[1]) <= max_angle && fabs(q[2]) <= max_angle)) {
@@ -202,20 +207,18 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
       const float s =
           patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
                           origin + q[0] * ray, normal_of(e_x, e_y, e_z, q[1], q[2]), trial);
-      if (improves(s, best)) {
-        best = s;
-        best_k = k;
+      ++evaluations;
+      if (improves(s, score)) {
+        moved = k;
+        p[k / 2] = q[k / 2];
+        score = s;
         for (int v = 0; v < num_views; ++v) {
-          best_nccs[v] = trial[v];
+          nccs[v] = trial[v];
         }
       }
     }
-    if (best_k >= 0) {
-      p[best_k / 2] += (best_k % 2 == 0) ? step[best_k / 2] : -step[best_k / 2];
-      score = best;
-      for (int v = 0; v < num_views; ++v) {
-        nccs[v] = best_nccs[v];
-      }
+    if (moved >= 0) {
+      lead = moved;
       ++moves;
     } else {
       for (int k = 0; k < 3; ++k) {
@@ -225,7 +228,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
     }
   }
   out.center = (float4)(origin + p[0] * ray, score);
-  out.normal = (float4)(normal_of(e_x, e_y, e_z, p[1], p[2]), 0.0f);
+  out.normal = (float4)(normal_of(e_x, e_y, e_z, p[1], p[2]), (float)evaluations);
   out.params = (float4)((p[0] - t0) / footprint, p[1], p[2], (float)moves);
   results[i] = out;
   for (int v = 0; v < num_views; ++v) {

@@ -249,6 +249,12 @@ TEST(OptionSpec, CheckpointRecordOfTheDefaultsIsTheOldOne) {
   MatcherOptions pmvs;
   pmvs.mode = MatchMode::kPmvs;
   EXPECT_EQ(OptionsJson(pmvs)["mode"], "pmvs");
+  // A later option is recorded once it is set, so that a run matched with
+  // it does not resume under another value.
+  MatcherOptions sparse;
+  sparse.adaptive_sample_step = 2.0;
+  EXPECT_EQ(MatcherOptionsJson(sparse)["adaptive_sample_step"], 2.0);
+  EXPECT_NE(MatcherOptionsJson(sparse), old);
 }
 
 TEST(OptionsReference, DocsAreCurrent) {

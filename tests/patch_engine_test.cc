@@ -201,5 +201,26 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
   EXPECT_EQ(accepted, 8);
 }
 
+// A large window keeps its extent and loses samples: the fewest odd grid
+// whose spacing stays at most the step asked for; the window size itself and
+// anything smaller sample every pixel.
+TEST(SampledWindowTest, SpansTheWindowWithTheFewestSamples) {
+  const struct {
+    int side;
+    double max_step;
+    int samples;
+    double step;
+  } cases[] = {{21, 2.0, 11, 2.0}, {15, 2.0, 9, 1.75},        {11, 2.0, 7, 5.0 / 3.0},
+               {21, 1.0, 21, 1.0}, {21, 1.5, 15, 10.0 / 7.0}, {7, 2.0, 7, 1.0},
+               {5, 2.0, 5, 1.0},   {21, 4.0, 7, 10.0 / 3.0}};
+  for (const auto& c : cases) {
+    const WindowGrid g = SampledWindow(c.side, 7, c.max_step);
+    EXPECT_EQ(g.samples, c.samples) << c.side << " px at most " << c.max_step << " apart";
+    EXPECT_NEAR(g.step, c.step, 1e-12) << c.side << " px at most " << c.max_step << " apart";
+    EXPECT_EQ(g.samples % 2, 1);
+    EXPECT_NEAR((g.samples - 1) * g.step, c.side <= 7 ? c.side - 1 : c.side - 1, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace sapmvs

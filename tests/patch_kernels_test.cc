@@ -159,6 +159,7 @@ TEST(ReferencePatchKernelsTest, IsTheDoubleReferenceInFloat) {
     }
     EXPECT_EQ(r.score, static_cast<float>(want[i].score)) << "patch " << i;
     EXPECT_EQ(r.moves, want[i].moves) << "patch " << i;
+    EXPECT_EQ(r.evaluations, want[i].evaluations) << "patch " << i;
     EXPECT_EQ(r.patch.reference, starts[i].reference);
     EXPECT_LT((Xyz(r.patch.center) - want[i].center).norm(), 1e-3 * want[i].center.norm());
     EXPECT_NEAR(r.depth_offset, want[i].depth_offset, 1e-6);
@@ -193,11 +194,12 @@ struct BackendCase {
   int height;
   uint32_t seed;
   double sigma_color;
+  double sample_step = 1.0;
 };
 
 void PrintTo(const BackendCase& c, std::ostream* out) {
   *out << "patch " << c.patch_size << ", " << c.width << "x" << c.height << ", sigma "
-       << c.sigma_color;
+       << c.sigma_color << ", step " << c.sample_step;
 }
 
 class PatchKernelsBackendsTest : public ClTest,
@@ -213,6 +215,7 @@ TEST_P(PatchKernelsBackendsTest, ScoresAgree) {
   NccScorerOptions so;
   so.patch_size = c.patch_size;
   so.sigma_color = c.sigma_color;
+  so.sample_step = c.sample_step;
   const std::unique_ptr<PatchKernels> device = MakeClPatchKernels(context());
   const std::unique_ptr<PatchKernels> reference = Reference();
   device->SetGroup(scene.group);
@@ -220,7 +223,8 @@ TEST_P(PatchKernelsBackendsTest, ScoresAgree) {
   const std::vector<float> got = device->Score(so, patches, pairs, nullptr);
   const std::vector<float> want = reference->Score(so, patches, pairs, nullptr);
   std::vector<double> margin;
-  NccScoreReference(scene.group, patches, pairs, c.patch_size, &margin, c.sigma_color);
+  NccScoreReference(scene.group, patches, pairs, c.patch_size, &margin, c.sigma_color,
+                    c.sample_step);
   ASSERT_EQ(got.size(), want.size());
   int valid = 0, nan = 0, ambiguous = 0;
   double worst = 0;
@@ -257,6 +261,7 @@ TEST_P(PatchKernelsBackendsTest, RefinementsAgree) {
   PatchRefinerOptions ro;
   ro.patch_size = c.patch_size;
   ro.sigma_color = c.sigma_color;
+  ro.sample_step = c.sample_step;
   // The matcher's search, then a short one whose steps stay large, so that
   // most decisions are clear and the paths must be the same.
   for (const int iterations : {kDefaultRefineIterations, 4}) {
@@ -275,6 +280,7 @@ TEST_P(PatchKernelsBackendsTest, RefinementsAgree) {
       if (want[i].decision_margin <= kSafeMargin) continue;
       ++same_path;
       EXPECT_EQ(got[i].moves, want[i].moves) << "patch " << i;
+      EXPECT_EQ(got[i].evaluations, want[i].evaluations) << "patch " << i;
       EXPECT_NEAR(got[i].depth_offset, want[i].depth_offset, kDepthTol) << "patch " << i;
       EXPECT_NEAR(got[i].yaw, want[i].yaw, kAngleTol) << "patch " << i;
       EXPECT_NEAR(got[i].pitch, want[i].pitch, kAngleTol) << "patch " << i;
@@ -292,7 +298,9 @@ INSTANTIATE_TEST_SUITE_P(OddSizes, PatchKernelsBackendsTest,
                          ::testing::Values(BackendCase{3, 97, 83, 81, 0.0},
                                            BackendCase{7, 161, 123, 85, 3.0},
                                            BackendCase{11, 131, 97, 83, 0.0},
-                                           BackendCase{21, 201, 161, 84, 3.0}));
+                                           BackendCase{21, 201, 161, 84, 3.0},
+                                           // A 15 px window on 9 samples (SampledWindow).
+                                           BackendCase{9, 163, 121, 86, 3.0, 1.75}));
 
 }  // namespace
 }  // namespace sapmvs

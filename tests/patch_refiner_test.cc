@@ -81,6 +81,7 @@ RefComparison CompareWithReference(const std::vector<RefinedPatch>& got,
     if (e.decision_margin > kSafeMargin) {
       ++c.same_path;
       EXPECT_EQ(g.moves, e.moves) << "patch " << i;
+      EXPECT_EQ(g.evaluations, e.evaluations) << "patch " << i;
       EXPECT_NEAR(g.depth_offset, e.depth_offset, kDepthTol) << "patch " << i;
       EXPECT_NEAR(g.yaw, e.yaw, kAngleTol) << "patch " << i;
       EXPECT_NEAR(g.pitch, e.pitch, kAngleTol) << "patch " << i;

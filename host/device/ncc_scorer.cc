@@ -23,11 +23,13 @@ static_assert(sizeof(NccPair) == sizeof(cl_int2), "NccPair is uploaded as int2")
 
 }  // namespace
 
-BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color) {
+BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color,
+                             double sample_step) {
   BuildOptions defines;
   defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
       .Define("NCC_SIGMA_COLOR", static_cast<float>(sigma_color))
       .Define("PATCH_SIZE", patch_size)
+      .Define("SAMPLE_STEP", static_cast<float>(sample_step))
       .Define("WORK_GROUP_SIZE", work_group_size);
   return defines;
 }
@@ -36,9 +38,9 @@ NccScorer::NccScorer(ClContext& context, const NccScorerOptions& options)
     : context_(context), options_(options) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("NccScorerOptions: expected " + problem);
-  const ClProgram& program = context_.Program(
-      kKernelFile,
-      NccBuildOptions(options.patch_size, options.work_group_size, options.sigma_color));
+  const ClProgram& program =
+      context_.Program(kKernelFile, NccBuildOptions(options.patch_size, options.work_group_size,
+                                                    options.sigma_color, options.sample_step));
   score_kernel_ = program.Kernel(kScoreKernel);
   probe_kernel_ = program.Kernel(kProbeKernel);
 }

@@ -25,7 +25,8 @@ namespace sapmvs {
 // patch_refine.cl and roofline_probe.cl): the NCC's variance floor, the
 // sample weights, the patch side and the work-group size, so that the three
 // score alike.
-BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color);
+BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_color,
+                             double sample_step = 1.0);
 
 // ---------------------------------------------------------------------------
 

@@ -26,8 +26,8 @@ PatchRefiner::PatchRefiner(ClContext& context, const PatchRefinerOptions& option
     : context_(context), options_(options) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("PatchRefinerOptions: expected " + problem);
-  BuildOptions defines =
-      NccBuildOptions(options.patch_size, options.work_group_size, options.sigma_color);
+  BuildOptions defines = NccBuildOptions(options.patch_size, options.work_group_size,
+                                         options.sigma_color, options.sample_step);
   defines.Define("MAX_VIEWS", kMaxViews);
   kernel_ = context_.Program(kKernelFile, defines).Kernel(kKernel);
 }
@@ -99,6 +99,7 @@ std::vector<RefinedPatch> PatchRefiner::Refine(const std::vector<NccPatch>& patc
     r.yaw = out[i].params.s[1];
     r.pitch = out[i].params.s[2];
     r.moves = static_cast<int>(out[i].params.s[3]);
+    r.evaluations = static_cast<int>(out[i].normal.s[3]);
   }
   return refined;
 }

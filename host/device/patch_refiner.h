@@ -11,10 +11,10 @@
 //          reference camera), e_x = the reference x axis made orthogonal to
 //          e_z, e_y = e_z x e_x:
 //          n = cos(pitch) sin(yaw) e_x + sin(pitch) e_y + cos(pitch) cos(yaw) e_z.
-// Each iteration scores p +- step_k on each parameter (order +t, -t, +yaw,
-// -yaw, +pitch, -pitch), moves to the best candidate if it strictly beats the
-// current mean NCC, and otherwise halves all steps, stopping early after
-// max_halvings halvings. A candidate is invalid
+// Each iteration polls p +- step_k on each parameter (order +t, -t, +yaw,
+// -yaw, +pitch, -pitch, starting from the direction that moved last), moves
+// to the first candidate that strictly beats the current mean NCC, and
+// otherwise halves all steps, stopping early after max_halvings halvings. A candidate is invalid
 // (never accepted) when any view's NCC is NaN or |yaw| or |pitch| exceeds
 // max_angle_deg.
 

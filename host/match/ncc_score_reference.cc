@@ -27,7 +27,8 @@ double BorderDistance(const ImageLayout& layout, double x, double y) {
 }  // namespace
 
 double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, int view,
-                                  int patch_size, double sigma_color, double* border_margin) {
+                                  int patch_size, double sigma_color, double* border_margin,
+                                  double sample_step) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const int half = patch_size / 2;
   const size_t num_samples = static_cast<size_t>(patch_size) * patch_size;
@@ -43,7 +44,9 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
   const Eigen::Vector3d n = Xyz(patch.normal);
   const double depth = Xyzw(ref.p[2]).dot(c.homogeneous());
   if (!(depth > 0.0)) return nan;
-  const double step = depth / ref.center.s[3];
+  // The kernel's SAMPLE_STEP is a float literal.
+  const double step =
+      static_cast<double>(static_cast<float>(sample_step)) * (depth / ref.center.s[3]);
   // Same grid axes as the kernel (see ncc_score.cl).
   const Eigen::Vector3d x_proj = Xyz(ref.x_axis) - Xyz(ref.x_axis).dot(n) * n;
   if (!(x_proj.norm() >= kNccMinAxisLength)) return nan;
@@ -117,10 +120,12 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
 
 std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<NccPatch>& patches,
                                       const std::vector<NccPair>& pairs, int patch_size,
-                                      std::vector<double>* border_margin, double sigma_color) {
+                                      std::vector<double>* border_margin, double sigma_color,
+                                      double sample_step) {
   NccScorerOptions options;
   options.patch_size = patch_size;
   options.sigma_color = sigma_color;
+  options.sample_step = sample_step;
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("NccScoreReference: expected " + problem);
   group.Validate();
@@ -132,9 +137,9 @@ std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<N
   const long n = static_cast<long>(pairs.size());
 #pragma omp parallel for schedule(dynamic, 64)
   for (long i = 0; i < n; ++i) {
-    scores[i] =
-        NccScoreReferenceUnchecked(group, patches[pairs[i].patch], pairs[i].view, patch_size,
-                                   sigma_color, border_margin ? &(*border_margin)[i] : nullptr);
+    scores[i] = NccScoreReferenceUnchecked(
+        group, patches[pairs[i].patch], pairs[i].view, patch_size, sigma_color,
+        border_margin ? &(*border_margin)[i] : nullptr, sample_step);
   }
   return scores;
 }

@@ -17,16 +17,18 @@ namespace sapmvs {
 // pixels from any sample position to the edge of its image's valid region
 // (negative outside): where it is within float32 rounding of 0 the kernel may
 // legitimately decide the other way. `sigma_color`: as
-// NccScorerOptions::sigma_color. Pairs are scored in parallel (OpenMP).
+// NccScorerOptions::sigma_color, `sample_step` as NccScorerOptions::sample_step.
+// Pairs are scored in parallel (OpenMP).
 std::vector<double> NccScoreReference(const NccGroup& group, const std::vector<NccPatch>& patches,
                                       const std::vector<NccPair>& pairs, int patch_size,
                                       std::vector<double>* border_margin = nullptr,
-                                      double sigma_color = 0.0);
+                                      double sigma_color = 0.0, double sample_step = 1.0);
 
 // The score of one patch in `view` for callers that validated the group, the
 // patch, the view and the options already (the refinement scores thousands of
 // candidates per patch). `border_margin` as above, may be null.
 double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, int view,
-                                  int patch_size, double sigma_color, double* border_margin);
+                                  int patch_size, double sigma_color, double* border_margin,
+                                  double sample_step = 1.0);
 
 }  // namespace sapmvs

@@ -17,6 +17,15 @@ bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d
 
 }  // namespace
 
+WindowGrid SampledWindow(int side, int window_size, double max_step) {
+  const int half = side / 2;
+  if (side <= window_size || half == 0) return {side, 1.0};
+  // A hair under max_step first, so that a spacing of exactly max_step is
+  // not pushed to one more sample by rounding.
+  const int intervals = static_cast<int>(std::ceil(half / max_step - 1e-9));
+  return {2 * intervals + 1, static_cast<double>(half) / intervals};
+}
+
 double PatchEngine::SigmaColor() const {
   if (options_.mode != MatchMode::kSapmvs) return 0.0;
   return options_.ncc_sigma_color;
@@ -32,7 +41,10 @@ PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
     for (const int size : options_.adaptive_sizes) {
       if (size <= options_.window_size) continue;
       PatchRefinerOptions po;
-      po.patch_size = size;
+      const WindowGrid grid =
+          SampledWindow(size, options_.window_size, options_.adaptive_sample_step);
+      po.patch_size = grid.samples;
+      po.sample_step = grid.step;
       po.iterations = kPolishIterations;
       po.depth_step = kPolishDepthStep;
       po.angle_step_deg = kPolishAngleStepDeg;
@@ -50,14 +62,13 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
   if (patches.empty()) return {};
   double seconds = 0;
   std::vector<RefinedPatch> out = kernels_.Refine(ro, patches, views, &seconds);
-  const int size = ro.patch_size;
-  // Rounds run: each either moved or halved, up to the halving limit.
+  // Labelled by the window's side in pixels.
+  const int size = static_cast<int>(std::lround((ro.patch_size - 1) * ro.sample_step)) + 1;
   double evaluations = 0;
   for (size_t i = 0; i < views.size(); ++i) {
-    const int rounds = std::min(ro.iterations, out[i].moves + ro.max_halvings);
-    evaluations += static_cast<double>(views[i].size()) * (1 + 6 * rounds);
+    evaluations += static_cast<double>(views[i].size()) * out[i].evaluations;
   }
-  Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size), size,
+  Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size), ro.patch_size,
         static_cast<long>(patches.size()), evaluations, seconds);
   return out;
 }

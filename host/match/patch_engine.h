@@ -56,6 +56,16 @@ struct AcceptedPatch {
   int size = 0;            // side of the accepted patch, pixels
 };
 
+// The sample grid that scores a window of `side` pixels: `samples` per side
+// (odd), `step` pixels apart, spanning the side end to end. A side up to
+// window_size samples every pixel; a larger one the fewest samples that keep
+// the spacing at most max_step (MatcherOptions::adaptive_sample_step).
+struct WindowGrid {
+  int samples = 0;
+  double step = 1.0;
+};
+WindowGrid SampledWindow(int side, int window_size, double max_step);
+
 class PatchEngine {
  public:
   // Hands `group` to `kernels` (PatchKernels::SetGroup) until the engine is

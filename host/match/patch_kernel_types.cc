@@ -67,6 +67,10 @@ std::string NccScorerOptions::Problem() const {
     return "patch_size <= kMaxPatchSize = " + std::to_string(kMaxPatchSize) + got;
   }
   if (o.patch_size % 2 != 1) return "patch_size is odd" + got;
+  if (!(o.sample_step >= 1.0 && o.sample_step <= kMaxSampleStep)) {
+    return "sample_step 1 to " + std::to_string(kMaxSampleStep) +
+           " (sample_step = " + std::to_string(o.sample_step) + ")";
+  }
   if (o.work_group_size < 1) {
     return "work_group_size >= 1 (work_group_size = " + std::to_string(o.work_group_size) + ")";
   }
@@ -88,6 +92,10 @@ std::string PatchRefinerOptions::Problem() const {
   if (o.patch_size < 3 || o.patch_size > kMaxPatchSize || o.patch_size % 2 != 1) {
     return "patch_size odd, 3 to " + std::to_string(kMaxPatchSize) +
            " (patch_size = " + std::to_string(o.patch_size) + ")";
+  }
+  if (!(o.sample_step >= 1.0 && o.sample_step <= kMaxSampleStep)) {
+    return "sample_step 1 to " + std::to_string(kMaxSampleStep) +
+           " (sample_step = " + std::to_string(o.sample_step) + ")";
   }
   if (o.work_group_size < 1) {
     return "work_group_size >= 1 (work_group_size = " + std::to_string(o.work_group_size) + ")";

@@ -74,7 +74,7 @@ static_assert(sizeof(NccPair) == 8, "NccPair is uploaded as int2");
 // One refined patch as the refinement kernel writes it (48 bytes, 3 x float4).
 struct RefinedPatchOut {
   Float4 center;  // xyz: refined centre; w: mean NCC over the views (NaN: none valid).
-  Float4 normal;  // xyz: refined unit normal; w: 0.
+  Float4 normal;  // xyz: refined unit normal; w: candidates scored, the start included.
   Float4 params;  // x: t - t0 in footprints of the start; y: yaw; z: pitch (radians);
                   // w: number of accepted moves.
 };
@@ -100,6 +100,12 @@ struct NccScorerOptions {
   // μ: samples per side of the patch grid, passed as -D PATCH_SIZE. Odd, 3 to
   // kMaxPatchSize.
   int patch_size = kDefaultPatchSize;
+  // Spacing of the samples, in reference pixels (the footprints of one
+  // reference pixel on the patch), passed as -D SAMPLE_STEP: the grid spans
+  // (patch_size - 1) * sample_step pixels. 1 samples every pixel (PMVS);
+  // larger steps let a large window be scored from fewer samples. Finite,
+  // 1 to kMaxSampleStep.
+  double sample_step = 1.0;
   // Work-items per work-group, passed as -D WORK_GROUP_SIZE. Must be >= 1;
   // the device limits are checked at launch (the CPU reference ignores it).
   int work_group_size = kDefaultWorkGroupSize;
@@ -121,6 +127,8 @@ struct NccScorerOptions {
 struct PatchRefinerOptions {
   // μ: samples per side of the patch grid (-D PATCH_SIZE). Odd, 3 to kMaxPatchSize.
   int patch_size = kDefaultPatchSize;
+  // Spacing of the samples in reference pixels (NccScorerOptions::sample_step).
+  double sample_step = 1.0;
   // Work-items per work-group (-D WORK_GROUP_SIZE), >= 1 (the CPU reference
   // ignores it).
   int work_group_size = kDefaultWorkGroupSize;
@@ -154,6 +162,7 @@ struct RefinedPatch {
   float yaw = 0.0f;                // Radians.
   float pitch = 0.0f;              // Radians.
   int moves = 0;                   // Accepted moves.
+  int evaluations = 0;             // Candidates scored, the start included.
 };
 
 // Throws Error naming the first pair or patch the kernel must not see: an

@@ -76,7 +76,7 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
       const NccPatch candidate = MakeNccPatch(f.origin + q[0] * f.ray, n, patch.reference);
       for (size_t k = 0; k < list.size(); ++k) {
         (*nccs)[k] = NccScoreReferenceUnchecked(group, candidate, list[k], options.patch_size,
-                                                options.sigma_color, nullptr);
+                                                options.sigma_color, nullptr, options.sample_step);
       }
       double sum = 0.0;
       for (double s : *nccs) {
@@ -98,32 +98,29 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
     double margin = inf;
     std::vector<double> trial;
     int halvings = 0;
+    int lead = 0;
+    r.evaluations = 1;
     for (int it = 0; it < options.iterations && halvings < options.max_halvings; ++it) {
-      double best = score;
-      int best_k = -1;
-      std::vector<double> valid_scores;
-      if (!std::isnan(score)) valid_scores.push_back(score);
-      std::vector<double> best_nccs;
-      for (int k = 0; k < 6; ++k) {
+      int moved = -1;
+      for (int j = 0; j < 6 && moved < 0; ++j) {
+        const int k = (lead + j) % 6;
         double q[3] = {p[0], p[1], p[2]};
         q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
+        // Out-of-range angles are skipped without a score, as in the kernel.
+        if (!(std::abs(q[1]) <= max_angle && std::abs(q[2]) <= max_angle)) continue;
         const double s = evaluate(q, &trial);
-        if (!std::isnan(s)) valid_scores.push_back(s);
-        if (improves(s, best)) {
-          best = s;
-          best_k = k;
-          best_nccs = trial;
+        ++r.evaluations;
+        // Each comparison is a decision float32 could take the other way.
+        if (!std::isnan(s) && !std::isnan(score)) margin = std::min(margin, std::abs(s - score));
+        if (improves(s, score)) {
+          moved = k;
+          p[k / 2] = q[k / 2];
+          score = s;
+          r.view_scores = trial;
         }
       }
-      // Gap between the winner and the runner-up among the valid scores.
-      std::sort(valid_scores.begin(), valid_scores.end());
-      if (valid_scores.size() >= 2) {
-        margin = std::min(margin, valid_scores.back() - valid_scores[valid_scores.size() - 2]);
-      }
-      if (best_k >= 0) {
-        p[best_k / 2] += (best_k % 2 == 0) ? step[best_k / 2] : -step[best_k / 2];
-        score = best;
-        r.view_scores = best_nccs;
+      if (moved >= 0) {
+        lead = moved;
         ++r.moves;
       } else {
         for (double& s : step) s *= 0.5;

@@ -23,9 +23,10 @@ struct RefinedPatchReference {
   double yaw = 0.0;
   double pitch = 0.0;
   int moves = 0;
-  // Smallest gap, over every decision of the search, between the winning
-  // score (the current one when nothing improved) and the best other valid
-  // score. Where it is above float32 noise the kernel takes the same path.
+  int evaluations = 0;  // Candidates scored, the start included.
+  // Smallest gap, over every decision of the search, between a candidate's
+  // score and the current score it was compared with. Where it is above
+  // float32 noise the kernel takes the same path.
   double decision_margin = 0.0;
 };
 

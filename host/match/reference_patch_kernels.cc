@@ -41,7 +41,8 @@ class ReferencePatchKernels : public PatchKernels {
     }
     const auto start = std::chrono::steady_clock::now();
     const std::vector<double> scores =
-        NccScoreReference(group_, patches, pairs, options.patch_size, nullptr, options.sigma_color);
+        NccScoreReference(group_, patches, pairs, options.patch_size, nullptr, options.sigma_color,
+                          options.sample_step);
     std::vector<float> out(scores.begin(), scores.end());
     Time(start, seconds);
     return out;
@@ -66,6 +67,7 @@ class ReferencePatchKernels : public PatchKernels {
       o.yaw = static_cast<float>(r.yaw);
       o.pitch = static_cast<float>(r.pitch);
       o.moves = r.moves;
+      o.evaluations = r.evaluations;
     }
     Time(start, seconds);
     return out;

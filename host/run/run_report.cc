@@ -27,7 +27,13 @@ void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
   WriteStreamAtomically(path, [&](std::ostream& f) { f << std::setw(2) << j << "\n"; });
 }
 
-nlohmann::json MatcherOptionsJson(const MatcherOptions& m) { return OptionsJson(m); }
+nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
+  nlohmann::json j = OptionsJson(m);
+  // Added after version 1 of the checkpoints; at 1 it matches as they did,
+  // so it is recorded only otherwise, and their runs still resume.
+  if (m.adaptive_sample_step == 1.0) j.erase("adaptive_sample_step");
+  return j;
+}
 
 nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   nlohmann::json j;

@@ -23,10 +23,9 @@ struct KernelTime {
   long launches = 0;
   long items = 0;  // work items: patches (refinement) or (patch, view) pairs (scoring)
   // NCC evaluations of one patch in one view pair, each over patch_size^2
-  // samples: one per pair for scoring; for refinement the upper bound
-  // sum over patches of views * (1 + 6 * rounds), rounds = min(iterations,
-  // moves + max_halvings) (a candidate that
-  // leaves the image stops early).
+  // samples: one per pair for scoring; for refinement the sum over patches
+  // of views * the candidates the kernel scored (a view whose samples leave
+  // the image stops a candidate's score early, so this is an upper bound).
   double ncc_evaluations = 0;
   int patch_size = 0;
   double seconds = 0;      // device time, summed (0 without queue profiling)
