@@ -61,6 +61,35 @@ float sample_image(__global const float* images, __global const int4* table, int
   return bilinear_at(images + t.x, t.y, t.z, t.w, x, y);
 }
 
+// The grid axes of the patch (c, n) seen from `ref`: one sample step along
+// the grid's columns (dx) and rows (dy). The step is SAMPLE_STEP footprints
+// of one reference pixel at c, depth / f (the third row of K [R | t] gives
+// the depth along the optical axis); dx follows the reference x axis
+// projected onto the plane, dy the in-plane perpendicular turned towards the
+// reference y axis, so the grid follows the reference image's rows and
+// columns (as PMVS's getPAxes). False when c is not in front of the
+// reference or the plane (nearly) contains its x axis.
+bool patch_axes(const NccCamera ref, float3 c, float3 n, float3* dx, float3* dy) {
+  const float depth = dot(ref.p2, (float4)(c, 1.0f));
+  if (!(depth > 0.0f)) {
+    return false;
+  }
+  const float step = SAMPLE_STEP * (depth / ref.center.w);
+  const float3 x_proj = ref.x_axis.xyz - dot(ref.x_axis.xyz, n) * n;
+  const float x_length = length(x_proj);
+  if (!(x_length >= NCC_MIN_AXIS_LENGTH)) {
+    return false;
+  }
+  const float3 x_dir = x_proj / x_length;
+  float3 y_dir = cross(n, x_dir);
+  if (dot(y_dir, ref.y_axis.xyz) < 0.0f) {
+    y_dir = -y_dir;
+  }
+  *dx = step * x_dir;
+  *dy = step * y_dir;
+  return true;
+}
+
 // The homogeneous projections of a patch grid into one camera. The grid lies
 // on a plane, so projection is linear in the grid indices: the sample at
 // offsets (r, col) from the centre projects to h0 + r hy + col hx. Three dot

@@ -48,31 +48,11 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_s
   const float3 c = patch.center.xyz;
   const float3 n = patch.normal.xyz;
 
-  // Grid spacing: SAMPLE_STEP footprints of one reference pixel at c,
-  // depth / f (the third row of K [R | t] gives the depth along the optical
-  // axis).
-  const float depth = dot(ref.p2, (float4)(c, 1.0f));
-  if (!(depth > 0.0f)) {
+  float3 dx, dy;
+  if (!patch_axes(ref, c, n, &dx, &dy)) {
     scores[i] = NAN;
     return;
   }
-  const float step = SAMPLE_STEP * (depth / ref.center.w);
-  // In-plane axes: the reference x axis projected onto the plane, and the
-  // in-plane perpendicular turned towards the reference y axis, so the grid
-  // follows the reference image's rows and columns (as PMVS's getPAxes).
-  const float3 x_proj = ref.x_axis.xyz - dot(ref.x_axis.xyz, n) * n;
-  const float x_length = length(x_proj);
-  if (!(x_length >= NCC_MIN_AXIS_LENGTH)) {
-    scores[i] = NAN;
-    return;
-  }
-  const float3 x_dir = x_proj / x_length;
-  float3 y_dir = cross(n, x_dir);
-  if (dot(y_dir, ref.y_axis.xyz) < 0.0f) {
-    y_dir = -y_dir;
-  }
-  const float3 dx = step * x_dir;
-  const float3 dy = step * y_dir;
 
   float a[NCC_NUM_SAMPLES];
   float b[NCC_NUM_SAMPLES];

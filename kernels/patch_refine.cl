@@ -54,23 +54,10 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
     nccs[v] = NAN;
   }
   const NccCamera ref = cameras[reference];
-  const float depth = dot(ref.p2, (float4)(c, 1.0f));
-  if (!(depth > 0.0f)) {
+  float3 dx, dy;
+  if (!patch_axes(ref, c, n, &dx, &dy)) {
     return NAN;
   }
-  const float step = SAMPLE_STEP * (depth / ref.center.w);
-  const float3 x_proj = ref.x_axis.xyz - dot(ref.x_axis.xyz, n) * n;
-  const float x_length = length(x_proj);
-  if (!(x_length >= NCC_MIN_AXIS_LENGTH)) {
-    return NAN;
-  }
-  const float3 x_dir = x_proj / x_length;
-  float3 y_dir = cross(n, x_dir);
-  if (dot(y_dir, ref.y_axis.xyz) < 0.0f) {
-    y_dir = -y_dir;
-  }
-  const float3 dx = step * x_dir;
-  const float3 dy = step * y_dir;
   const int half_size = PATCH_SIZE / 2;
 
   // The reference samples once, shared by every view.

@@ -120,6 +120,17 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   for (const GroupCloud& g : groups) {
     if (!g.cloud) throw Error("merge: a group has no cloud");
   }
+  if (groups.size() == 1) {
+    // One group has no duplicates across groups and owns its whole core:
+    // every point stays, in order (what the loop below gives, without its
+    // sort and grid: 0.4 s of a 10 s run on `small` as one group).
+    const long n = static_cast<long>(groups.front().cloud->points.size());
+    order.reserve(static_cast<size_t>(n));
+    for (long i = 0; i < n; ++i) order.push_back({0, static_cast<size_t>(i), true});
+    st.input = st.kept = n;
+    st.kept_by_group[0] = st.core_by_group[0] = n;
+    return order;
+  }
 
   std::vector<Eigen::Vector2d> centers;
   for (const GroupCloud& g : groups) centers.push_back(g.center);
