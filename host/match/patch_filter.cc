@@ -9,6 +9,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "sapmvs/util/error.h"
+
 namespace sapmvs {
 namespace {
 
@@ -157,28 +159,58 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   flann::Matrix<float> data(xyz.data(), alive.size(), 3);
   flann::Index<flann::L2<float>> index(data, flann::KDTreeSingleIndexParams(10));
   index.buildIndex();
-  std::vector<size_t> nn(alive.size() * k);
-  std::vector<float> nd(alive.size() * k);
-  flann::Matrix<size_t> nn_m(nn.data(), alive.size(), k);
-  flann::Matrix<float> nd_m(nd.data(), alive.size(), k);
-  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
-  params.cores = 0;
-  index.knnSearch(data, nn_m, nd_m, k, params);
+  // Each point's neighbour radius (neighbour_radius footprints).
+  std::vector<float> radius(alive.size());
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    radius[a] = static_cast<float>(options.neighbour_radius *
+                                   Footprint(group.images[patches[p.patch].ref].camera, p.x));
+  }
+  // nn[a * k + j]: the j-th nearest neighbour of point a when it lies within
+  // a's radius and is not a itself, else -1. Searched in chunks, so that
+  // FLANN's size_t indices and distances exist for one chunk only: whole,
+  // they were 80 % of the filter's memory and set the group's peak.
+  constexpr size_t kChunk = 16384;
+  if (alive.size() > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+    throw Error("filter: " + std::to_string(alive.size()) +
+                " points in one group, more than its neighbour index holds (2^31 - 1)");
+  }
+  std::vector<int32_t> nn(alive.size() * k, -1);
+  {
+    std::vector<size_t> chunk_nn(kChunk * k);
+    std::vector<float> chunk_nd(kChunk * k);
+    flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
+    params.cores = 0;
+    for (size_t first = 0; first < alive.size(); first += kChunk) {
+      const size_t rows = std::min(kChunk, alive.size() - first);
+      flann::Matrix<float> queries(xyz.data() + 3 * first, rows, 3);
+      flann::Matrix<size_t> nn_m(chunk_nn.data(), rows, k);
+      flann::Matrix<float> nd_m(chunk_nd.data(), rows, k);
+      index.knnSearch(queries, nn_m, nd_m, k, params);
+      for (size_t r = 0; r < rows; ++r) {
+        const size_t a = first + r;
+        for (int j = 0; j < k; ++j) {
+          const size_t b = chunk_nn[r * k + j];
+          if (b == a || chunk_nd[r * k + j] > radius[a] * radius[a]) continue;
+          nn[a * k + j] = static_cast<int32_t>(b);
+        }
+      }
+    }
+  }
 
   // Distances, in footprints, from each patch's plane to the points of other
   // patches among its points' neighbours (NaN for the other neighbours): the
   // plane tolerance and test 2b below both come from them.
-  std::vector<float> radius(alive.size());
   std::vector<float> foreign_distance(alive.size() * k, std::nanf(""));
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
     const AcceptedPatch& patch = patches[p.patch];
     const double fp = Footprint(group.images[patch.ref].camera, p.x);
-    radius[a] = static_cast<float>(options.neighbour_radius * fp);
     for (int j = 0; j < k; ++j) {
-      const size_t b = nn[a * k + j];
-      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const int32_t b = nn[a * k + j];
+      if (b < 0) continue;
       const DensePoint& q = points[alive[b]];
       if (q.patch == p.patch) continue;
       foreign_distance[a * k + j] =
@@ -213,8 +245,8 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     const double fp = Footprint(group.images[patches[p.patch].ref].camera, p.x);
     std::vector<Eigen::Vector3d> nbr;
     for (int j = 0; j < k; ++j) {
-      const size_t b = nn[a * k + j];
-      if (b == a || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const int32_t b = nn[a * k + j];
+      if (b < 0) continue;
       nbr.push_back(points[alive[b]].x);
     }
     if (static_cast<int>(nbr.size()) < options.min_neighbours) continue;
@@ -261,8 +293,8 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   for (size_t a = 0; a < alive.size(); ++a) {
     if (!pass[a]) continue;
     for (int j = 0; j < k; ++j) {
-      const size_t b = nn[a * k + j];
-      if (b == a || !pass[b] || nd[a * k + j] > radius[a] * radius[a]) continue;
+      const int32_t b = nn[a * k + j];
+      if (b < 0 || !pass[b]) continue;
       const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, static_cast<int>(b));
       if (ra != rb) parent[ra] = rb;
     }
