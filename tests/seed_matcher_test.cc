@@ -3,10 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
+#include "match/group_data.h"
+#include "plane_scene.h"
 #include "sapmvs/block/camera.h"
+#include "sapmvs/match/matcher_options.h"
 
 namespace sapmvs {
 namespace {
@@ -85,6 +90,122 @@ TEST(TriangulateMidpoint, ParallelRaysFromTwoCentresAreNotFinite) {
     const Eigen::Vector3d got = TriangulateMidpoint(a, uv, b, uv);
     EXPECT_FALSE(got.allFinite()) << "uv (" << uv.transpose() << "): " << got.transpose();
   }
+}
+
+// The candidates of feature f of image 0 in image 1 by their definition, over
+// every feature of image 1: the same kind, within epipolar_distance of the
+// segment between the seed depths, and triangulated within those depths.
+std::vector<Eigen::Vector3d> BruteForceCandidates(const MatchGroupData& group, const Feature& f,
+                                                  const std::vector<Feature>& others,
+                                                  double epipolar_distance) {
+  const MatchImage& ref = group.images[0];
+  const Camera& cam = group.images[1].camera;
+  const Eigen::Vector3d near_point = ref.camera.BackProject(f.uv, kSeedDepthMin * ref.depth);
+  const Eigen::Vector3d far_point = ref.camera.BackProject(f.uv, kSeedDepthMax * ref.depth);
+  const Eigen::Vector2d a = cam.Project(near_point), b = cam.Project(far_point);
+  std::vector<Eigen::Vector3d> out;
+  for (const Feature& g : others) {
+    if (g.kind != f.kind) continue;
+    const double t = (g.uv - a).dot(b - a) / (b - a).squaredNorm();
+    if (t < 0 || t > 1 || (g.uv - (a + t * (b - a))).norm() > epipolar_distance) continue;
+    const Eigen::Vector3d x = TriangulateMidpoint(ref.camera, f.uv, cam, g.uv);
+    const double depth = ref.camera.Depth(x);
+    if (!x.allFinite() || depth < kSeedDepthMin * ref.depth || depth > kSeedDepthMax * ref.depth) {
+      continue;
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
+// Seed matching searches only the features near each epipolar segment (a
+// bucket walk along it, clipped to the image): it must find exactly the
+// candidates a scan of every feature finds, including features just inside
+// and just outside epipolar_distance, features of the other kind on the
+// line, and segments that leave the image.
+TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
+  const test::PlaneScene scene = test::MakePlaneScene(2, 241, 181, 17);
+  MatchGroupData group;
+  for (int i = 0; i < 2; ++i) {
+    MatchImage image;
+    image.camera = scene.cameras[i];
+    image.views = {1 - i};
+    image.depth = image.camera.Depth(test::GroundAt(image.camera, Eigen::Vector2d(120, 90)));
+    group.images.push_back(image);
+  }
+  MatcherOptions options;
+  options.candidates_per_feature = 100000;  // keep every candidate
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> x(0.0, 240.0), y(0.0, 180.0);
+  std::vector<std::vector<Feature>> features(2);
+  // Image 0: features all over it, near its borders too.
+  for (int k = 0; k < 60; ++k) {
+    Feature f;
+    f.uv = Eigen::Vector2d(x(rng), y(rng));
+    f.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
+    features[0].push_back(f);
+  }
+  // Image 1: random features, plus for each feature of image 0 its match on
+  // the ground and features 1.9 and 2.1 px across its epipolar line, and one
+  // of the other kind on the line; all inside the image, as detected ones are.
+  for (int k = 0; k < 1500; ++k) {
+    Feature g;
+    g.uv = Eigen::Vector2d(x(rng), y(rng));
+    g.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
+    features[1].push_back(g);
+  }
+  const Camera& c0 = group.images[0].camera;
+  const Camera& c1 = group.images[1].camera;
+  for (const Feature& f : features[0]) {
+    const Eigen::Vector2d on = c1.Project(test::GroundAt(c0, f.uv));
+    const Eigen::Vector2d along =
+        (c1.Project(c0.BackProject(f.uv, kSeedDepthMax * group.images[0].depth)) -
+         c1.Project(c0.BackProject(f.uv, kSeedDepthMin * group.images[0].depth)))
+            .normalized();
+    const Eigen::Vector2d across(-along.y(), along.x());
+    auto inside = [](const Eigen::Vector2d& uv) {
+      return uv.x() >= 0 && uv.y() >= 0 && uv.x() <= 240 && uv.y() <= 180;
+    };
+    for (const double offset : {0.0, 1.9, -1.9, 2.1, -2.1}) {
+      Feature g;
+      g.uv = on + offset * across;
+      g.kind = f.kind;
+      if (inside(g.uv)) features[1].push_back(g);
+    }
+    Feature other;
+    other.uv = on;
+    other.kind = f.kind == FeatureKind::kHarris ? FeatureKind::kDog : FeatureKind::kHarris;
+    if (inside(other.uv)) features[1].push_back(other);
+  }
+
+  const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  long compared = 0, candidates = 0;
+  for (const Feature& f : features[0]) {
+    std::vector<Eigen::Vector3d> want =
+        BruteForceCandidates(group, f, features[1], options.epipolar_distance);
+    const auto found = std::find_if(seeds.begin(), seeds.end(), [&](const SeedFeature& s) {
+      return s.image == 0 && s.uv == f.uv;
+    });
+    std::vector<Eigen::Vector3d> got;
+    if (found != seeds.end()) {
+      for (const PatchCandidate& c : found->candidates) got.push_back(c.center);
+    }
+    ASSERT_EQ(got.size(), want.size()) << "feature at " << f.uv.transpose();
+    auto less = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+      return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+    };
+    std::sort(got.begin(), got.end(), less);
+    std::sort(want.begin(), want.end(), less);
+    for (size_t k = 0; k < got.size(); ++k) {
+      EXPECT_LT((got[k] - want[k]).norm(), 1e-9) << "feature at " << f.uv.transpose();
+    }
+    ++compared;
+    candidates += static_cast<long>(want.size());
+  }
+  EXPECT_EQ(compared, static_cast<long>(features[0].size()));
+  // Each feature has at least its ground match and the two within 1.9 px,
+  // where its segment stays over image 1.
+  EXPECT_GT(candidates, 2 * static_cast<long>(features[0].size()));
 }
 
 }  // namespace
