@@ -108,6 +108,9 @@ TEST(PatchRefinerOptionsTest, CheckRejectsBadValues) {
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.patch_size = 4; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.patch_size = kMaxPatchSize + 2; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.work_group_size = 0; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.sample_step = 0.5; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.sample_step = kMaxSampleStep + 0.5; }));
+  EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.sample_step = std::nan(""); }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.iterations = -1; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.iterations = kMaxRefineIterations + 1; }));
   EXPECT_TRUE(bad([](PatchRefinerOptions& o) { o.max_halvings = 0; }));

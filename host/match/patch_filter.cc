@@ -159,13 +159,13 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   flann::Matrix<float> data(xyz.data(), alive.size(), 3);
   flann::Index<flann::L2<float>> index(data, flann::KDTreeSingleIndexParams(10));
   index.buildIndex();
-  // Each point's neighbour radius (neighbour_radius footprints).
-  std::vector<float> radius(alive.size());
+  // Each point's footprint in its reference image: its neighbour radius
+  // (neighbour_radius of them) and the unit of the plane distances below.
+  std::vector<double> footprint(alive.size());
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
-    radius[a] = static_cast<float>(options.neighbour_radius *
-                                   Footprint(group.images[patches[p.patch].ref].camera, p.x));
+    footprint[a] = Footprint(group.images[patches[p.patch].ref].camera, p.x);
   }
   // nn[a * k + j]: the j-th nearest neighbour of point a when it lies within
   // a's radius and is not a itself, else -1. Searched in chunks, so that
@@ -190,9 +190,10 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       index.knnSearch(queries, nn_m, nd_m, k, params);
       for (size_t r = 0; r < rows; ++r) {
         const size_t a = first + r;
+        const float radius = static_cast<float>(options.neighbour_radius * footprint[a]);
         for (int j = 0; j < k; ++j) {
           const size_t b = chunk_nn[r * k + j];
-          if (b == a || chunk_nd[r * k + j] > radius[a] * radius[a]) continue;
+          if (b == a || chunk_nd[r * k + j] > radius * radius) continue;
           nn[a * k + j] = static_cast<int32_t>(b);
         }
       }
@@ -207,7 +208,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
     const AcceptedPatch& patch = patches[p.patch];
-    const double fp = Footprint(group.images[patch.ref].camera, p.x);
+    const double fp = footprint[a];
     for (int j = 0; j < k; ++j) {
       const int32_t b = nn[a * k + j];
       if (b < 0) continue;
@@ -242,7 +243,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
-    const double fp = Footprint(group.images[patches[p.patch].ref].camera, p.x);
+    const double fp = footprint[a];
     std::vector<Eigen::Vector3d> nbr;
     for (int j = 0; j < k; ++j) {
       const int32_t b = nn[a * k + j];

@@ -15,6 +15,19 @@ namespace {
 // renormalise, so a sloppy normal would silently shear the grid.
 constexpr double kUnitNormalTolerance = 1e-3;
 
+// The checks NccScorerOptions and PatchRefinerOptions share: "" or what was
+// expected.
+std::string SampleStepProblem(double sample_step) {
+  if (sample_step >= 1.0 && sample_step <= kMaxSampleStep) return "";
+  return "sample_step 1 to " + std::to_string(kMaxSampleStep) +
+         " (sample_step = " + std::to_string(sample_step) + ")";
+}
+
+std::string WorkGroupSizeProblem(int work_group_size) {
+  if (work_group_size >= 1) return "";
+  return "work_group_size >= 1 (work_group_size = " + std::to_string(work_group_size) + ")";
+}
+
 Float4 ToFloat4(double x, double y, double z, double w) {
   Float4 v;
   v.s[0] = static_cast<float>(x);
@@ -67,13 +80,8 @@ std::string NccScorerOptions::Problem() const {
     return "patch_size <= kMaxPatchSize = " + std::to_string(kMaxPatchSize) + got;
   }
   if (o.patch_size % 2 != 1) return "patch_size is odd" + got;
-  if (!(o.sample_step >= 1.0 && o.sample_step <= kMaxSampleStep)) {
-    return "sample_step 1 to " + std::to_string(kMaxSampleStep) +
-           " (sample_step = " + std::to_string(o.sample_step) + ")";
-  }
-  if (o.work_group_size < 1) {
-    return "work_group_size >= 1 (work_group_size = " + std::to_string(o.work_group_size) + ")";
-  }
+  if (std::string p = SampleStepProblem(o.sample_step); !p.empty()) return p;
+  if (std::string p = WorkGroupSizeProblem(o.work_group_size); !p.empty()) return p;
   if (!(std::isfinite(o.sigma_color) && o.sigma_color >= 0.0)) {
     return "sigma_color finite and >= 0 (sigma_color = " + std::to_string(o.sigma_color) + ")";
   }
@@ -93,13 +101,8 @@ std::string PatchRefinerOptions::Problem() const {
     return "patch_size odd, 3 to " + std::to_string(kMaxPatchSize) +
            " (patch_size = " + std::to_string(o.patch_size) + ")";
   }
-  if (!(o.sample_step >= 1.0 && o.sample_step <= kMaxSampleStep)) {
-    return "sample_step 1 to " + std::to_string(kMaxSampleStep) +
-           " (sample_step = " + std::to_string(o.sample_step) + ")";
-  }
-  if (o.work_group_size < 1) {
-    return "work_group_size >= 1 (work_group_size = " + std::to_string(o.work_group_size) + ")";
-  }
+  if (std::string p = SampleStepProblem(o.sample_step); !p.empty()) return p;
+  if (std::string p = WorkGroupSizeProblem(o.work_group_size); !p.empty()) return p;
   if (o.iterations < 0 || o.iterations > kMaxRefineIterations) {
     return "iterations 0 to " + std::to_string(kMaxRefineIterations) +
            " (iterations = " + std::to_string(o.iterations) + ")";
