@@ -5,6 +5,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "sapmvs/block/camera.h"
 
@@ -118,6 +120,94 @@ TEST(IntersectPlane, PlaneBehindTheCameraIsNan) {
     const Eigen::Vector3d ahead = camera.center() + 40 * ray;
     EXPECT_LE((IntersectPlane(camera, uv, ahead, ray) - ahead).norm(), 1e-9) << "trial " << trial;
   }
+}
+
+// Textured ground: grey 94 to 108 in a fine checker.
+cv::Mat Checker(int width, int height) {
+  cv::Mat grey(height, width, CV_32F);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) grey.at<float>(y, x) = ((x + y) % 2 ? 106.0f : 94.0f) + x % 3;
+  }
+  return grey;
+}
+
+std::set<std::pair<int, int>> PixelSet(const std::vector<std::pair<int, int>>& v) {
+  return {v.begin(), v.end()};
+}
+
+const auto kNoBarrier = [](int, int) { return false; };
+
+TEST(WindowPixels, WithoutWeightsOrBarriersIsTheWholeWindowInsideTheImage) {
+  const cv::Mat grey = Checker(40, 30);
+  for (const int side : {3, 7, 11, 21}) {
+    const auto all = WindowPixels(grey, 20, 15, side, 3.0, 0.0, kNoBarrier);
+    EXPECT_EQ(static_cast<int>(all.size()), side * side) << side;
+    EXPECT_EQ(all.front(), std::make_pair(20, 15));
+    EXPECT_EQ(PixelSet(all).size(), all.size());
+    EXPECT_EQ(WindowPixels(grey, 20, 15, side, 0.0, 0.3, kNoBarrier).size(), all.size());
+  }
+  // Clipped at the image's border: the corner's 11 x 11 window keeps 6 x 6.
+  EXPECT_EQ(WindowPixels(grey, 0, 0, 11, 0.0, 0.0, kNoBarrier).size(), 36u);
+  EXPECT_EQ(WindowPixels(grey, 39, 29, 11, 3.0, 0.3, kNoBarrier).size(), 36u);
+  EXPECT_TRUE(WindowPixels(grey, 40, 0, 11, 3.0, 0.3, kNoBarrier).empty());
+}
+
+TEST(WindowPixels, StopsAtAStepEdge) {
+  // A bright roof (x >= 23) beside textured ground: a ground window that
+  // reaches over the edge writes no point on the roof, and keeps all of its
+  // ground.
+  cv::Mat grey = Checker(50, 40);
+  grey(cv::Rect(23, 0, 27, 40)).setTo(200.0f);
+  const auto got = PixelSet(WindowPixels(grey, 19, 20, 21, 3.0, 0.3, kNoBarrier));
+  for (int y = 10; y <= 30; ++y) {
+    for (int x = 9; x <= 29; ++x) {
+      EXPECT_EQ(got.count({x, y}), x < 23 ? 1u : 0u) << x << ", " << y;
+    }
+  }
+  // A flat centre has no texture to weigh by: the whole window.
+  const auto roof = PixelSet(WindowPixels(grey, 30, 20, 7, 3.0, 0.3, kNoBarrier));
+  EXPECT_EQ(roof.size(), 49u);
+}
+
+TEST(WindowPixels, AWallStripeClosesTheWindowBehindIt) {
+  // A dark wall two pixels wide (x = 24, 25) across the window: the ground
+  // beyond it looks like the centre's but is not connected to it.
+  cv::Mat grey = Checker(50, 40);
+  grey(cv::Rect(24, 0, 2, 40)).setTo(20.0f);
+  const auto got = PixelSet(WindowPixels(grey, 20, 20, 15, 3.0, 0.3, kNoBarrier));
+  for (const auto& [x, y] : got) EXPECT_LT(x, 24) << x << ", " << y;
+  EXPECT_EQ(got.size(), 11u * 15u);  // x = 13 to 23
+}
+
+TEST(WindowPixels, KeepsToOneSideOfATreeCrown) {
+  // A crown: a disk of radius 6 of a darker, textured green.
+  cv::Mat grey = Checker(60, 60);
+  for (int y = 0; y < 60; ++y) {
+    for (int x = 0; x < 60; ++x) {
+      if ((x - 30) * (x - 30) + (y - 30) * (y - 30) <= 36) {
+        grey.at<float>(y, x) = ((x + y) % 2 ? 43.0f : 37.0f);
+      }
+    }
+  }
+  auto in_crown = [](int x, int y) { return (x - 30) * (x - 30) + (y - 30) * (y - 30) <= 36; };
+  // From the ground beside it, none of the crown.
+  for (const auto& [x, y] : WindowPixels(grey, 22, 30, 21, 3.0, 0.3, kNoBarrier)) {
+    EXPECT_FALSE(in_crown(x, y)) << x << ", " << y;
+  }
+  // From the crown, none of the ground, and all of the crown in the window.
+  const auto crown = WindowPixels(grey, 30, 30, 21, 3.0, 0.3, kNoBarrier);
+  for (const auto& [x, y] : crown) EXPECT_TRUE(in_crown(x, y)) << x << ", " << y;
+  EXPECT_EQ(crown.size(), 113u);  // the pixels of the disk of radius 6
+}
+
+TEST(WindowPixels, AMatchedEdgeLineIsABarrier) {
+  // An 8-connected diagonal barrier line through the window: the far side
+  // stays out although its grey levels are the centre's.
+  const cv::Mat grey = Checker(40, 40);
+  auto diagonal = [](int x, int y) { return x + y == 44; };
+  const auto got = WindowPixels(grey, 20, 20, 21, 3.0, 0.3, diagonal);
+  ASSERT_FALSE(got.empty());
+  for (const auto& [x, y] : got) EXPECT_LT(x + y, 44) << x << ", " << y;
 }
 
 }  // namespace

@@ -169,6 +169,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
              "wave " + std::to_string(wave) + ", " + std::to_string(size) + " candidates, " +
                  std::to_string(emitted) + " points");
     });
+    stats.removed_unfitted += propagator.RefitPlanes();
     end_stage("propagation");
     report("filter", pass + 1, options.expand_iterations);
 

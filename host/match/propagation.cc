@@ -1,7 +1,10 @@
 #include "match/propagation.h"
 
+#include "match/plane_refit.h"
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace sapmvs {
@@ -16,6 +19,57 @@ const int kDirections8[8][2] = {{1, 0}, {-1, 0}, {0, 1},  {0, -1},
                                 {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
 
 }  // namespace
+
+std::vector<std::pair<int, int>> WindowPixels(const cv::Mat& grey, int cx, int cy, int side,
+                                              double sigma_color, double min_weight,
+                                              const std::function<bool(int, int)>& barrier) {
+  std::vector<std::pair<int, int>> out;
+  if (cx < 0 || cy < 0 || cx >= grey.cols || cy >= grey.rows) return out;
+  auto at = [&](int x, int y) { return static_cast<double>(grey.at<float>(y, x)); };
+  // |d| <= reach keeps exp(-d^2 / 2 s^2) >= min_weight.
+  double reach = std::numeric_limits<double>::infinity();
+  if (sigma_color > 0 && min_weight > 0) {
+    double mean = 0, var = 0;
+    int n = 0;
+    for (int y = std::max(0, cy - 1); y <= std::min(grey.rows - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(grey.cols - 1, cx + 1); ++x) {
+        mean += at(x, y);
+        ++n;
+      }
+    }
+    mean /= n;
+    for (int y = std::max(0, cy - 1); y <= std::min(grey.rows - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(grey.cols - 1, cx + 1); ++x) {
+        var += (at(x, y) - mean) * (at(x, y) - mean);
+      }
+    }
+    const double s = sigma_color * std::sqrt(var / n);
+    if (s > 0) reach = s * std::sqrt(-2.0 * std::log(std::min(1.0, min_weight)));
+  }
+  const double centre = at(cx, cy);
+  const int h = side / 2;
+  // 4-connected, so that an 8-connected edge line is a closed barrier.
+  std::vector<uint8_t> seen(static_cast<size_t>(side) * side, 0);
+  std::vector<std::pair<int, int>> stack = {{cx, cy}};
+  seen[static_cast<size_t>(h) * side + h] = 1;
+  while (!stack.empty()) {
+    const auto [x, y] = stack.back();
+    stack.pop_back();
+    out.emplace_back(x, y);
+    const int next[4][2] = {{x + 1, y}, {x - 1, y}, {x, y + 1}, {x, y - 1}};
+    for (const auto& q : next) {
+      const int lx = q[0] - cx + h, ly = q[1] - cy + h;
+      if (lx < 0 || ly < 0 || lx >= side || ly >= side) continue;
+      if (q[0] < 0 || q[1] < 0 || q[0] >= grey.cols || q[1] >= grey.rows) continue;
+      uint8_t& s = seen[static_cast<size_t>(ly) * side + lx];
+      if (s) continue;
+      s = 1;
+      if (std::abs(at(q[0], q[1]) - centre) > reach || barrier(q[0], q[1])) continue;
+      stack.emplace_back(q[0], q[1]);
+    }
+  }
+  return out;
+}
 
 Eigen::Vector3d IntersectPlane(const Camera& camera, const Eigen::Vector2d& uv,
                                const Eigen::Vector3d& c, const Eigen::Vector3d& n) {
@@ -91,28 +145,11 @@ bool Propagator::Emit(const AcceptedPatch& patch) {
       points_.push_back(d);
     }
   } else {
-    // Flood fill of the L x L window from its centre; 4-connected, so an
-    // 8-connected edge line is a closed barrier.
-    const int h = patch.size / 2;
-    const int side = patch.size;
-    std::vector<uint8_t> seen(static_cast<size_t>(side) * side, 0);
-    std::vector<std::pair<int, int>> stack = {{cx, cy}};
-    seen[static_cast<size_t>(h) * side + h] = 1;
-    while (!stack.empty()) {
-      const auto [x, y] = stack.back();
-      stack.pop_back();
+    const auto pixels = WindowPixels(
+        group_.images[patch.ref].grey, cx, cy, patch.size, options_.ncc_sigma_color,
+        options_.emit_min_weight, [&](int x, int y) { return IsBarrier(patch.ref, x, y, patch); });
+    for (const auto& [x, y] : pixels) {
       emit_at(x, y, IntersectPlane(cam, Eigen::Vector2d(x, y), patch.center, patch.normal));
-      const int next[4][2] = {{x + 1, y}, {x - 1, y}, {x, y + 1}, {x, y - 1}};
-      for (const auto& q : next) {
-        const int lx = q[0] - cx + h, ly = q[1] - cy + h;
-        if (lx < 0 || ly < 0 || lx >= side || ly >= side) continue;
-        if (q[0] < 0 || q[1] < 0 || q[0] >= cam.width() || q[1] >= cam.height()) continue;
-        uint8_t& s = seen[static_cast<size_t>(ly) * side + lx];
-        if (s) continue;
-        s = 1;
-        if (IsBarrier(patch.ref, q[0], q[1], patch)) continue;
-        stack.emplace_back(q[0], q[1]);
-      }
     }
   }
   if (points_.size() == first_point) return false;
@@ -222,6 +259,38 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
     seed_depths_[patches_[p].ref].push_back(cam.Depth(patches_[p].center));
     Expand(static_cast<int>(p), &front_);
   }
+}
+
+long Propagator::RefitPlanes() {
+  if (options_.mode != MatchMode::kSapmvs || options_.refit_neighbours <= 0) return 0;
+  std::vector<uint8_t> alive(patches_.size(), 0);
+  for (const DensePoint& d : points_) alive[d.patch] = 1;
+  const std::vector<Eigen::Vector3d> fitted = FitPatchNormals(group_, options_, patches_, alive);
+  std::vector<Eigen::Vector2d> centre_uv(patches_.size());
+  for (size_t p = 0; p < patches_.size(); ++p) {
+    if (!alive[p]) continue;
+    if (!fitted[p].isZero()) patches_[p].normal = fitted[p];
+    centre_uv[p] = group_.images[patches_[p].ref].camera.Project(patches_[p].center);
+  }
+  const size_t before = points_.size();
+  size_t out = 0;
+  for (size_t i = 0; i < points_.size(); ++i) {
+    DensePoint d = points_[i];
+    const AcceptedPatch& patch = patches_[d.patch];
+    if (fitted[d.patch].isZero()) {
+      const Eigen::Vector2d off = d.uv.cast<double>() - centre_uv[d.patch];
+      // Pixel uv lies within kUnfittedReach of the rounded centre.
+      if (off.cwiseAbs().maxCoeff() > kUnfittedReach + 0.5) continue;
+    } else {
+      const Eigen::Vector3d x = IntersectPlane(group_.images[patch.ref].camera, d.uv.cast<double>(),
+                                               patch.center, patch.normal);
+      if (!x.allFinite()) continue;
+      d.x = x;
+    }
+    points_[out++] = d;
+  }
+  points_.resize(out);
+  return static_cast<long>(before - out);
 }
 
 void Propagator::Prune(const std::vector<bool>& keep) {

@@ -75,6 +75,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   sum->removed_neighbourhood += s.removed_neighbourhood;
   sum->removed_clusters += s.removed_clusters;
   sum->removed_depth_range += s.removed_depth_range;
+  sum->removed_unfitted += s.removed_unfitted;
   sum->points += s.points;
   for (const auto& [name, t] : s.stages) {
     auto it = std::find_if(sum->stages.begin(), sum->stages.end(),

@@ -56,6 +56,7 @@ nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
                  {"removed_neighbourhood", s.removed_neighbourhood},
                  {"removed_clusters", s.removed_clusters},
                  {"removed_depth_range", s.removed_depth_range},
+                 {"removed_unfitted", s.removed_unfitted},
                  {"points", s.points}};
   nlohmann::json stages = nlohmann::json::array();
   for (const auto& [name, t] : s.stages) {

@@ -52,6 +52,7 @@ struct MatchStats {
   long removed_neighbourhood = 0;
   long removed_clusters = 0;
   long removed_depth_range = 0;  // far outside the depths the image's seeds span
+  long removed_unfitted = 0;     // sapmvs: off the centre of a plane no neighbour confirms
   long points = 0;
   std::vector<std::pair<std::string, StageTime>> stages;  // in order
   std::map<std::string, KernelTime> kernels;

@@ -70,6 +70,23 @@ struct MatcherOptions {
   // 73.0 % coverage; 3: 72.4 %; NGI keeps 87 % of its points at 3, 76 % at
   // 2). 0 = plain NCC; pmvs mode always scores plain NCC, as PMVS does.
   double ncc_sigma_color = 3.0;
+  // sapmvs: a pixel of an accepted window gets a point only where the
+  // weighted NCC gave it at least this weight (ncc_sigma_color), so that a
+  // plane is not written across the roof edge or crown rim that the weights
+  // discounted. 0.3 keeps grey levels within 1.55 s of the centre's: on
+  // `small` 91.9 -> 94.3 % within 1 GSD at 75.6 % coverage (76.0 % with
+  // every pixel). 0 = every pixel the flood fill reaches, as the paper.
+  double emit_min_weight = 0.3;
+  // sapmvs: each patch's plane is fitted to the centres of this many nearest
+  // patches (plane_refit.h) after each expansion, and its points moved onto
+  // it; a patch that fewer than 3 of them confirm keeps only the points
+  // within 1 pixel of its centre. 0 = off: every point stays on its refined
+  // plane, whose normal a small window hardly constrains.
+  int refit_neighbours = 16;
+  // sapmvs: a neighbour's centre confirms a patch's plane when it lies within
+  // this many footprints of it: one keeps the patches of a roof out of the
+  // ground's fit, and those of the ground out of the roof's.
+  double refit_tolerance = 1.0;
   // Features kept per detector per 32 x 32 pixel block (PMVS: 4). 8 seeds
   // the roofs that 4 left without a single right seed: on `small` coverage
   // 72.4 -> 75.5 % (sapmvs) and 63.8 -> 64.9 % (pmvs) at the same accuracy
@@ -204,6 +221,24 @@ void VisitFields(MatcherOptions& o, F&& f) {
         .Range(AtLeast(0))
         .Help("sapmvs: NCC sample weights, in SDs of the texture at the window's centre (0 = "
               "plain NCC)"));
+  f(Field(o.emit_min_weight, "emit_min_weight")
+        .Flag("--emit-min-weight")
+        .In(s)
+        .Range(Between(0, 1))
+        .Help("sapmvs: a window pixel gets a point only with at least this NCC sample weight (0 "
+              "= every pixel)"));
+  f(Field(o.refit_neighbours, "refit_neighbours")
+        .Flag("--refit-neighbours")
+        .In(s)
+        .Unit("patches")
+        .Range(Between(0, 64))
+        .Help("sapmvs: fit each patch plane to this many neighbouring centres (0 = off)"));
+  f(Field(o.refit_tolerance, "refit_tolerance")
+        .Flag("--refit-tolerance")
+        .In(s)
+        .Unit("footprints")
+        .Range(Above(0))
+        .Help("sapmvs: a neighbouring centre within this of a patch plane confirms it"));
   s = "Seeds and edges";
   f(Field(o.features_per_block, "features_per_block")
         .Flag("--features-per-block")
