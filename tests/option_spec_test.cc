@@ -232,9 +232,10 @@ TEST(OptionSpec, PlanTakesOnlyTheMatcherFieldsAPlanDependsOn) {
 }
 
 // groups/plan.json of a run resumes only when its matcher record equals the
-// new one: the record of the default options must stay what version 1 of
-// the checkpoints wrote (keys and values), or every old run would be refused.
-TEST(OptionSpec, CheckpointRecordOfTheDefaultsIsTheOldOne) {
+// new one: the record of the options that match as version 1 of the
+// checkpoints did must stay what version 1 wrote (keys and values), and the
+// defaults, which now match otherwise, must differ from it.
+TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   const nlohmann::json old = nlohmann::json::parse(R"({
     "mode": "sapmvs", "level": 1, "cell_size": 2, "threshold": 0.7, "threshold_before": 0.4,
     "min_image_num": 3, "max_angle_deg": 10.0, "view_angle_deg": 60.0, "window_size": 7,
@@ -244,14 +245,22 @@ TEST(OptionSpec, CheckpointRecordOfTheDefaultsIsTheOldOne) {
     "expand_iterations": 3, "score_fence": 3.0, "depth_tolerance": 3.0,
     "neighbour_radius": 4.0, "min_neighbours": 4, "plane_tolerance": 0.5,
     "plane_sigmas": 1.5, "min_cluster_size": 30})");
-  EXPECT_EQ(MatcherOptionsJson(MatcherOptions{}), old)
-      << MatcherOptionsJson(MatcherOptions{}).dump(2);
+  MatcherOptions v1;
+  v1.emit_min_weight = 0;
+  v1.refit_neighbours = 0;
+  v1.refit_tolerance = 2;  // unused without the refit, so not recorded
+  EXPECT_EQ(MatcherOptionsJson(v1), old) << MatcherOptionsJson(v1).dump(2);
+  const nlohmann::json defaults = MatcherOptionsJson(MatcherOptions{});
+  EXPECT_NE(defaults, old);
+  EXPECT_EQ(defaults["emit_min_weight"], 0.3);
+  EXPECT_EQ(defaults["refit_neighbours"], 16);
+  EXPECT_EQ(defaults["refit_tolerance"], 1.0);
   MatcherOptions pmvs;
   pmvs.mode = MatchMode::kPmvs;
   EXPECT_EQ(OptionsJson(pmvs)["mode"], "pmvs");
   // A later option is recorded once it is set, so that a run matched with
   // it does not resume under another value.
-  MatcherOptions sparse;
+  MatcherOptions sparse = v1;
   sparse.adaptive_sample_step = 2.0;
   EXPECT_EQ(MatcherOptionsJson(sparse)["adaptive_sample_step"], 2.0);
   EXPECT_NE(MatcherOptionsJson(sparse), old);

@@ -29,9 +29,18 @@ void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
 
 nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
   nlohmann::json j = OptionsJson(m);
-  // Added after version 1 of the checkpoints; at 1 it matches as they did,
-  // so it is recorded only otherwise, and their runs still resume.
+  // Added after version 1 of the checkpoints: each is recorded only when it
+  // matches otherwise than version 1 did (adaptive_sample_step 1, every pixel
+  // of a window emitted, no plane refit), so that a version 1 run resumes
+  // exactly when the groups still to match would be matched as its others
+  // were. The new defaults do not: such a run resumes with
+  // --emit-min-weight 0 --refit-neighbours 0, or starts over.
   if (m.adaptive_sample_step == 1.0) j.erase("adaptive_sample_step");
+  if (m.emit_min_weight == 0.0) j.erase("emit_min_weight");
+  if (m.refit_neighbours == 0) {
+    j.erase("refit_neighbours");
+    j.erase("refit_tolerance");
+  }
   return j;
 }
 
