@@ -249,12 +249,17 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   v1.emit_min_weight = 0;
   v1.refit_neighbours = 0;
   v1.refit_tolerance = 2;  // unused without the refit, so not recorded
+  v1.refill_cut = true;    // likewise
   EXPECT_EQ(MatcherOptionsJson(v1), old) << MatcherOptionsJson(v1).dump(2);
   const nlohmann::json defaults = MatcherOptionsJson(MatcherOptions{});
   EXPECT_NE(defaults, old);
   EXPECT_EQ(defaults["emit_min_weight"], 0.3);
   EXPECT_EQ(defaults["refit_neighbours"], 16);
-  EXPECT_EQ(defaults["refit_tolerance"], 1.0);
+  EXPECT_EQ(defaults["refit_tolerance"], 0.7);
+  EXPECT_FALSE(defaults.contains("refill_cut"));
+  MatcherOptions refill;
+  refill.refill_cut = true;
+  EXPECT_EQ(MatcherOptionsJson(refill)["refill_cut"], true);
   MatcherOptions pmvs;
   pmvs.mode = MatchMode::kPmvs;
   EXPECT_EQ(OptionsJson(pmvs)["mode"], "pmvs");

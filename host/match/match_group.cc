@@ -169,7 +169,16 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
              "wave " + std::to_string(wave) + ", " + std::to_string(size) + " candidates, " +
                  std::to_string(emitted) + " points");
     });
-    stats.removed_unfitted += propagator.RefitPlanes();
+    const long cut = propagator.RefitPlanes();
+    stats.removed_unfitted += cut;
+    if (cut > 0 && options.refill_cut) {
+      propagator.RunWaves([&](long wave, long size, long emitted) {
+        report("propagation", pass + 1, options.expand_iterations,
+               "refill wave " + std::to_string(wave) + ", " + std::to_string(size) +
+                   " candidates, " + std::to_string(emitted) + " points");
+      });
+      stats.removed_unfitted += propagator.RefitPlanes();
+    }
     end_stage("propagation");
     report("filter", pass + 1, options.expand_iterations);
 

@@ -171,6 +171,7 @@ bool Propagator::Emit(const AcceptedPatch& patch) {
 
 void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
   const AcceptedPatch& patch = patches_[patch_index];
+  if (cut_.size() < patches_.size()) cut_.resize(patches_.size(), 0);
   const Camera& cam = group_.images[patch.ref].camera;
   Grid& grid = grids_[patch.ref];
   const int cs = options_.cell_size;
@@ -206,7 +207,7 @@ void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
     // Centring the new window wholly beyond the parent (a step longer by
     // hw - 1) left the ground between a patch and a wall or crown untried
     // (`small` at level 0: 85.6 % of the seen cells covered against 87.1 %).
-    const int step = patch.size / 2 + 2;
+    const int step = (cut_[patch_index] ? kUnfittedReach : patch.size / 2) + 2;
     const Eigen::Vector2d c(std::round(uv0.x()), std::round(uv0.y()));
     for (const auto& d : kDirections8) offer(c + step * Eigen::Vector2d(d[0], d[1]));
   }
@@ -261,10 +262,27 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
   }
 }
 
+void Propagator::Release(const DensePoint& d) {
+  const int cs = options_.cell_size;
+  auto free_cell = [&](Grid& grid, int cell) {
+    if (cell < 0 || grid.owner[cell] != d.patch) return;
+    grid.owner[cell] = -1;
+    grid.tries[cell] = 0;
+  };
+  const AcceptedPatch& patch = patches_[d.patch];
+  Grid& ref = grids_[patch.ref];
+  free_cell(ref, ref.Index(d.uv.cast<double>(), cs));
+  for (const int v : patch.views) {
+    const Camera& vc = group_.images[v].camera;
+    if (vc.Depth(d.x) > 0) free_cell(grids_[v], grids_[v].Index(vc.Project(d.x), cs));
+  }
+}
+
 long Propagator::RefitPlanes() {
   if (options_.mode != MatchMode::kSapmvs || options_.refit_neighbours <= 0) return 0;
   std::vector<uint8_t> alive(patches_.size(), 0);
   for (const DensePoint& d : points_) alive[d.patch] = 1;
+  cut_.resize(patches_.size(), 0);
   const std::vector<Eigen::Vector3d> fitted = FitPatchNormals(group_, options_, patches_, alive);
   std::vector<Eigen::Vector2d> centre_uv(patches_.size());
   for (size_t p = 0; p < patches_.size(); ++p) {
@@ -274,22 +292,34 @@ long Propagator::RefitPlanes() {
   }
   const size_t before = points_.size();
   size_t out = 0;
+  std::vector<int> newly_cut;
   for (size_t i = 0; i < points_.size(); ++i) {
     DensePoint d = points_[i];
     const AcceptedPatch& patch = patches_[d.patch];
     if (fitted[d.patch].isZero()) {
       const Eigen::Vector2d off = d.uv.cast<double>() - centre_uv[d.patch];
       // Pixel uv lies within kUnfittedReach of the rounded centre.
-      if (off.cwiseAbs().maxCoeff() > kUnfittedReach + 0.5) continue;
+      if (off.cwiseAbs().maxCoeff() > kUnfittedReach + 0.5) {
+        if (!cut_[d.patch]) newly_cut.push_back(d.patch);
+        cut_[d.patch] = 1;
+        Release(d);
+        continue;
+      }
     } else {
       const Eigen::Vector3d x = IntersectPlane(group_.images[patch.ref].camera, d.uv.cast<double>(),
                                                patch.center, patch.normal);
-      if (!x.allFinite()) continue;
+      if (!x.allFinite()) {
+        Release(d);
+        continue;
+      }
       d.x = x;
     }
     points_[out++] = d;
   }
   points_.resize(out);
+  // The ground the cut patches gave up is open to their expansion from the
+  // centre (Expand's step for a cut patch) and to their neighbours'.
+  for (const int p : newly_cut) Expand(p, &front_);
   return static_cast<long>(before - out);
 }
 

@@ -62,8 +62,11 @@ class Propagator {
   // sapmvs mode: fits each patch's plane to its neighbours' centres
   // (FitPatchNormals), moves its points onto the fitted plane, and keeps only
   // those within kUnfittedReach pixels of the centre of a patch whose plane
-  // none confirms. Returns the points dropped. No-op in pmvs mode, whose
-  // patches emit their centres only, and with refit_neighbours = 0.
+  // none confirms. The cells of the dropped points are freed, and a patch
+  // cut back is expanded from its centre (into the front, which RunWaves
+  // takes: MatcherOptions::refill_cut), as it is by every later Prune.
+  // Returns the points dropped. No-op in pmvs mode, whose patches emit their
+  // centres only, and with refit_neighbours = 0.
   long RefitPlanes();
 
   const std::vector<AcceptedPatch>& patches() const { return patches_; }
@@ -89,6 +92,8 @@ class Propagator {
   // cell was left for it.
   bool Emit(const AcceptedPatch& patch);
   void Expand(int patch_index, std::vector<PatchCandidate>* front);
+  // Frees the cells point d owns, in its reference and its patch's views.
+  void Release(const DensePoint& d);
   bool IsBarrier(int image, int x, int y, const AcceptedPatch& patch) const;
   // Accepts the evaluated candidates best score first; returns accepted indices.
   std::vector<int> AcceptBatch(std::vector<std::optional<AcceptedPatch>>& results);
@@ -101,6 +106,8 @@ class Propagator {
   std::vector<AcceptedPatch> patches_;
   std::vector<DensePoint> points_;
   std::vector<PatchCandidate> front_;
+  // cut_[p]: RefitPlanes cut patch p back to its centre, so it expands from there.
+  std::vector<uint8_t> cut_;
   std::vector<std::vector<double>> seed_depths_;
   long seeds_tried_ = 0, seeds_accepted_ = 0, candidates_ = 0, waves_ = 0, largest_wave_ = 0;
   long emitted_ = 0;

@@ -31,7 +31,7 @@ nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
   nlohmann::json j = OptionsJson(m);
   // Added after version 1 of the checkpoints: each is recorded only when it
   // matches otherwise than version 1 did (adaptive_sample_step 1, every pixel
-  // of a window emitted, no plane refit), so that a version 1 run resumes
+  // of a window emitted, no plane refit and so no refill), so that a version 1 run resumes
   // exactly when the groups still to match would be matched as its others
   // were. The new defaults do not: such a run resumes with
   // --emit-min-weight 0 --refit-neighbours 0, or starts over.
@@ -41,6 +41,7 @@ nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
     j.erase("refit_neighbours");
     j.erase("refit_tolerance");
   }
+  if (!m.refill_cut || m.refit_neighbours == 0) j.erase("refill_cut");
   return j;
 }
 
