@@ -62,9 +62,10 @@ class Propagator {
   // sapmvs mode: fits each patch's plane to its neighbours' centres
   // (FitPatchNormals), moves its points onto the fitted plane, and keeps only
   // those within kUnfittedReach pixels of the centre of a patch whose plane
-  // none confirms. The cells of the dropped points are freed, and a patch
-  // cut back is expanded from its centre (into the front, which RunWaves
-  // takes: MatcherOptions::refill_cut), as it is by every later Prune.
+  // none confirms. The cells of the dropped points are freed; with
+  // MatcherOptions::refill_cut a patch cut back is expanded from its centre
+  // into the front (which the next RunWaves takes), as it is by every later
+  // Prune.
   // Returns the points dropped. No-op in pmvs mode, whose patches emit their
   // centres only, and with refit_neighbours = 0.
   long RefitPlanes();
@@ -106,7 +107,8 @@ class Propagator {
   std::vector<AcceptedPatch> patches_;
   std::vector<DensePoint> points_;
   std::vector<PatchCandidate> front_;
-  // cut_[p]: RefitPlanes cut patch p back to its centre, so it expands from there.
+  // cut_[p]: RefitPlanes cut patch p back to its centre (with refill_cut it
+  // expands from there).
   std::vector<uint8_t> cut_;
   std::vector<std::vector<double>> seed_depths_;
   long seeds_tried_ = 0, seeds_accepted_ = 0, candidates_ = 0, waves_ = 0, largest_wave_ = 0;
