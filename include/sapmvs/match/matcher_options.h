@@ -74,8 +74,9 @@ struct MatcherOptions {
   // weighted NCC gave it at least this weight (ncc_sigma_color), so that a
   // plane is not written across the roof edge or crown rim that the weights
   // discounted. 0.3 keeps grey levels within 1.55 s of the centre's: on
-  // `small` 91.9 -> 94.3 % within 1 GSD at 75.6 % coverage (76.0 % with
-  // every pixel). 0 = every pixel the flood fill reaches, as the paper.
+  // `small` (one group, no refit) 91.9 -> 94.3 % within 1 GSD at 75.6 %
+  // coverage (75.9 % with every pixel). 0 = every pixel the flood fill
+  // reaches, as the paper.
   double emit_min_weight = 0.3;
   // sapmvs: each patch's plane is fitted to the centres of this many nearest
   // patches (plane_refit.h) after each expansion, and its points moved onto
@@ -87,15 +88,15 @@ struct MatcherOptions {
   // this many footprints of it, which keeps the patches of a roof out of the
   // ground's fit and those of the ground out of the roof's. Tighter is more
   // accurate and cuts more patches back: `compare_modes`, one group, within
-  // 1 GSD / coverage, `small` 96.0 / 75.1 % at 1, 96.7 / 75.4 % at 0.7, 97.1 /
-  // 73.2 % at 0.5; `city` 89.4 / 67.4 %, 90.7 / 66.6 %, 91.7 / 63.2 %; city
-  // against its LiDAR 93.4 % within 1 m at 1, 94.3 % at 0.7.
+  // 1 GSD / coverage, `small` 96.1 / 75.2 % at 1 and 96.8 / 74.4 % at 0.7;
+  // `city` 89.4 / 67.3 % and 90.7 / 65.7 %; city against its LiDAR (3
+  // groups) 93.4-93.9 % and 94.4 % within 1 m.
   double refit_tolerance = 0.7;
   // sapmvs: after each refit, propagate again into the pixels of the patches
-  // it cut back. More coverage for more time and a little accuracy:
-  // `compare_modes`, one group, with refit_tolerance 0.5, `small` 95.7 % within
-  // 1 GSD and 79.8 % coverage in 11.0 s (default: 96.7 %, 75.4 %, 7.9 s);
-  // `city` 88.6 %, 72.4 %, 25.9 s (90.7 %, 66.6 %, 17.7 s).
+  // it cut back, from their centres. More coverage for more time and a little
+  // accuracy: `compare_modes`, one group, with refit_tolerance 0.5, `small`
+  // 95.7 % within 1 GSD and 79.8 % coverage in 10.4 s (default: 96.8 %,
+  // 74.4 %, 7.7 s); `city` 88.6 %, 72.4 %, 26.3 s (90.7 %, 65.7 %, 16.6 s).
   bool refill_cut = false;
   // Features kept per detector per 32 x 32 pixel block (PMVS: 4). 8 seeds
   // the roofs that 4 left without a single right seed: on `small` coverage
