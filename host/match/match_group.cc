@@ -164,19 +164,18 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   // filter freed; every pass filters all points, old and new.
   for (int pass = 0; pass < options.expand_iterations; ++pass) {
     if (pass > 0) propagator.Prune(keep);
-    propagator.RunWaves([&](long wave, long size, long emitted) {
-      report("propagation", pass + 1, options.expand_iterations,
-             "wave " + std::to_string(wave) + ", " + std::to_string(size) + " candidates, " +
-                 std::to_string(emitted) + " points");
-    });
+    auto on_wave = [&](const std::string& what) {
+      return [&, what](long wave, long size, long emitted) {
+        report("propagation", pass + 1, options.expand_iterations,
+               what + " " + std::to_string(wave) + ", " + std::to_string(size) + " candidates, " +
+                   std::to_string(emitted) + " points");
+      };
+    };
+    propagator.RunWaves(on_wave("wave"));
     const long cut = propagator.RefitPlanes();
     stats.removed_unfitted += cut;
     if (cut > 0 && options.refill_cut) {
-      propagator.RunWaves([&](long wave, long size, long emitted) {
-        report("propagation", pass + 1, options.expand_iterations,
-               "refill wave " + std::to_string(wave) + ", " + std::to_string(size) +
-                   " candidates, " + std::to_string(emitted) + " points");
-      });
+      propagator.RunWaves(on_wave("refill wave"));
       stats.removed_unfitted += propagator.RefitPlanes();
     }
     end_stage("propagation");

@@ -26,6 +26,14 @@ double BorderDistance(const ImageLayout& layout, double x, double y) {
 
 }  // namespace
 
+double NccWeightScale(const double* values, int n, double sigma) {
+  double mean = 0.0, var = 0.0;
+  for (int k = 0; k < n; ++k) mean += values[k];
+  mean /= n;
+  for (int k = 0; k < n; ++k) var += std::pow(values[k] - mean, 2);
+  return sigma * std::sqrt(var / n);
+}
+
 double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, int view,
                                   int patch_size, double sigma_color, double* border_margin,
                                   double sample_step) {
@@ -83,13 +91,10 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
     // Same weights as ncc_weights: the spread of the 3 x 3 samples around
     // the centre, times sigma.
     const size_t mid = num_samples / 2;
-    double mean = 0.0, var = 0.0;
-    for (int r = -1; r <= 1; ++r)
-      for (int q = -1; q <= 1; ++q) mean += a[mid + r * patch_size + q];
-    mean /= 9.0;
-    for (int r = -1; r <= 1; ++r)
-      for (int q = -1; q <= 1; ++q) var += std::pow(a[mid + r * patch_size + q] - mean, 2);
-    const double s = sigma * std::sqrt(var / 9.0);
+    double centre[9];
+    for (int r = -1, k = 0; r <= 1; ++r)
+      for (int q = -1; q <= 1; ++q) centre[k++] = a[mid + r * patch_size + q];
+    const double s = NccWeightScale(centre, 9, sigma);
     for (size_t k = 0; k < num_samples; ++k) {
       const double d = a[k] - a[mid];
       weight[k] = s > 0.0 ? std::exp(-0.5 * (d * d) / (s * s)) : 1.0;

@@ -1,5 +1,6 @@
 #include "match/propagation.h"
 
+#include "match/ncc_score_reference.h"
 #include "match/plane_refit.h"
 
 #include <algorithm>
@@ -29,21 +30,14 @@ std::vector<std::pair<int, int>> WindowPixels(const cv::Mat& grey, int cx, int c
   // |d| <= reach keeps exp(-d^2 / 2 s^2) >= min_weight.
   double reach = std::numeric_limits<double>::infinity();
   if (sigma_color > 0 && min_weight > 0) {
-    double mean = 0, var = 0;
+    double centre[9];
     int n = 0;
     for (int y = std::max(0, cy - 1); y <= std::min(grey.rows - 1, cy + 1); ++y) {
       for (int x = std::max(0, cx - 1); x <= std::min(grey.cols - 1, cx + 1); ++x) {
-        mean += at(x, y);
-        ++n;
+        centre[n++] = at(x, y);
       }
     }
-    mean /= n;
-    for (int y = std::max(0, cy - 1); y <= std::min(grey.rows - 1, cy + 1); ++y) {
-      for (int x = std::max(0, cx - 1); x <= std::min(grey.cols - 1, cx + 1); ++x) {
-        var += (at(x, y) - mean) * (at(x, y) - mean);
-      }
-    }
-    const double s = sigma_color * std::sqrt(var / n);
+    const double s = NccWeightScale(centre, n, sigma_color);
     if (s > 0) reach = s * std::sqrt(-2.0 * std::log(std::min(1.0, min_weight)));
   }
   const double centre = at(cx, cy);
@@ -166,12 +160,12 @@ bool Propagator::Emit(const AcceptedPatch& patch) {
     }
   }
   patches_.push_back(patch);
+  cut_.push_back(0);
   return true;
 }
 
 void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
   const AcceptedPatch& patch = patches_[patch_index];
-  if (cut_.size() < patches_.size()) cut_.resize(patches_.size(), 0);
   const Camera& cam = group_.images[patch.ref].camera;
   Grid& grid = grids_[patch.ref];
   const int cs = options_.cell_size;
@@ -287,7 +281,6 @@ long Propagator::RefitPlanes() {
   if (options_.mode != MatchMode::kSapmvs || options_.refit_neighbours <= 0) return 0;
   std::vector<uint8_t> alive(patches_.size(), 0);
   for (const DensePoint& d : points_) alive[d.patch] = 1;
-  cut_.resize(patches_.size(), 0);
   const std::vector<Eigen::Vector3d> fitted = FitPatchNormals(group_, options_, patches_, alive);
   std::vector<Eigen::Vector2d> centre_uv(patches_.size());
   for (size_t p = 0; p < patches_.size(); ++p) {

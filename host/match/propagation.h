@@ -108,7 +108,7 @@ class Propagator {
   std::vector<DensePoint> points_;
   std::vector<PatchCandidate> front_;
   // cut_[p]: RefitPlanes cut patch p back to its centre (with refill_cut it
-  // expands from there).
+  // expands from there); one per patch, pushed with it.
   std::vector<uint8_t> cut_;
   std::vector<std::vector<double>> seed_depths_;
   long seeds_tried_ = 0, seeds_accepted_ = 0, candidates_ = 0, waves_ = 0, largest_wave_ = 0;
