@@ -13,7 +13,6 @@
 #include <type_traits>
 
 #include "run/options_reference.h"
-#include "run/run_report.h"
 #include "sapmvs/match/matcher_options.h"
 #include "sapmvs/plan/grouping_options.h"
 #include "sapmvs/run/cloud_dsm.h"
@@ -231,6 +230,29 @@ TEST(OptionSpec, PlanTakesOnlyTheMatcherFieldsAPlanDependsOn) {
                                           "--max-wave"}));
 }
 
+// A stand-in for an options struct that grew after version 1: `added` is
+// new and matches as version 1 at 0; `setting` only acts while `added` is on.
+struct GrownOptions {
+  int kept = 1;
+  int added = 0;
+  double setting = 0.5;
+};
+template <class F>
+void VisitFields(GrownOptions& o, F&& f) {
+  f(Field(o.kept, "kept"));
+  f(Field(o.added, "added").AsVersion1(0));
+  f(Field(o.setting, "setting").UnusedWhen(o.added == 0));
+}
+
+TEST(OptionSpec, CheckpointJsonLeavesOutVersion1ValuesAndUnusedFields) {
+  GrownOptions o;
+  EXPECT_EQ(OptionsJson(o), nlohmann::json({{"kept", 1}}));
+  o.setting = 2;  // still no effect while `added` is 0
+  EXPECT_EQ(OptionsJson(o), nlohmann::json({{"kept", 1}}));
+  o.added = 3;
+  EXPECT_EQ(OptionsJson(o), nlohmann::json({{"kept", 1}, {"added", 3}, {"setting", 2.0}}));
+}
+
 // groups/plan.json of a run resumes only when its matcher record equals the
 // new one: the record of the options that match as version 1 of the
 // checkpoints did must stay what version 1 wrote (keys and values), and the
@@ -250,8 +272,8 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   v1.refit_neighbours = 0;
   v1.refit_tolerance = 2;  // unused without the refit, so not recorded
   v1.refill_cut = true;    // likewise
-  EXPECT_EQ(MatcherOptionsJson(v1), old) << MatcherOptionsJson(v1).dump(2);
-  const nlohmann::json defaults = MatcherOptionsJson(MatcherOptions{});
+  EXPECT_EQ(OptionsJson(v1), old) << OptionsJson(v1).dump(2);
+  const nlohmann::json defaults = OptionsJson(MatcherOptions{});
   EXPECT_NE(defaults, old);
   EXPECT_EQ(defaults["emit_min_weight"], 0.3);
   EXPECT_EQ(defaults["refit_neighbours"], 16);
@@ -259,7 +281,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   EXPECT_FALSE(defaults.contains("refill_cut"));
   MatcherOptions refill;
   refill.refill_cut = true;
-  EXPECT_EQ(MatcherOptionsJson(refill)["refill_cut"], true);
+  EXPECT_EQ(OptionsJson(refill)["refill_cut"], true);
   MatcherOptions pmvs;
   pmvs.mode = MatchMode::kPmvs;
   EXPECT_EQ(OptionsJson(pmvs)["mode"], "pmvs");
@@ -267,8 +289,8 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   // it does not resume under another value.
   MatcherOptions sparse = v1;
   sparse.adaptive_sample_step = 2.0;
-  EXPECT_EQ(MatcherOptionsJson(sparse)["adaptive_sample_step"], 2.0);
-  EXPECT_NE(MatcherOptionsJson(sparse), old);
+  EXPECT_EQ(OptionsJson(sparse)["adaptive_sample_step"], 2.0);
+  EXPECT_NE(OptionsJson(sparse), old);
 }
 
 TEST(OptionsReference, DocsAreCurrent) {

@@ -6,6 +6,7 @@
 
 #include "run/run_report.h"
 #include "sapmvs/util/error.h"
+#include "util/option_json.h"
 
 namespace sapmvs {
 
@@ -30,7 +31,7 @@ nlohmann::json PlanRecord(const Block& block, const GroupingPlan& plan,
     for (const int i : g.images) names.push_back(block.images[i].name);
     groups.push_back(names);
   }
-  return {{"groups", groups}, {"matcher", MatcherOptionsJson(matcher)}};
+  return {{"groups", groups}, {"matcher", OptionsJson(matcher)}};
 }
 
 // group_NNN.ply or group_NNN.json, as CloudPath/StatusPath name them.

@@ -27,24 +27,6 @@ void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j) {
   WriteStreamAtomically(path, [&](std::ostream& f) { f << std::setw(2) << j << "\n"; });
 }
 
-nlohmann::json MatcherOptionsJson(const MatcherOptions& m) {
-  nlohmann::json j = OptionsJson(m);
-  // Added after version 1 of the checkpoints: each is recorded only when it
-  // matches otherwise than version 1 did (adaptive_sample_step 1, every pixel
-  // of a window emitted, no plane refit and so no refill), so that a version 1 run resumes
-  // exactly when the groups still to match would be matched as its others
-  // were. The new defaults do not: such a run resumes with
-  // --emit-min-weight 0 --refit-neighbours 0, or starts over.
-  if (m.adaptive_sample_step == 1.0) j.erase("adaptive_sample_step");
-  if (m.emit_min_weight == 0.0) j.erase("emit_min_weight");
-  if (m.refit_neighbours == 0) {
-    j.erase("refit_neighbours");
-    j.erase("refit_tolerance");
-  }
-  if (!m.refill_cut || m.refit_neighbours == 0) j.erase("refill_cut");
-  return j;
-}
-
 nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   nlohmann::json j;
   j["images"] = s.images;
@@ -141,7 +123,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["peak_rss_bytes"] = report.peak_rss_bytes;
   j["grouping"] = report.strategy;
   j["ungrouped"] = report.ungrouped;
-  j["matcher"] = MatcherOptionsJson(options.matcher);
+  j["matcher"] = OptionsJson(options.matcher);
   nlohmann::json groups = nlohmann::json::array();
   for (size_t g = 0; g < report.groups.size(); ++g) {
     const GroupRun& r = report.groups[g];

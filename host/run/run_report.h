@@ -14,8 +14,6 @@ namespace sapmvs {
 
 // Writes `j` (indented) to `path` atomically; throws Error naming the path.
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::json& j);
-// Every field of the options: what a checkpoint must agree on to be reused.
-nlohmann::json MatcherOptionsJson(const MatcherOptions& m);
 // Counts, per-stage wall times and kernel launches of one or more groups, and
 // the device times when `device_times` (measured only with --profile; absent
 // otherwise, so that no one reads an unmeasured 0 as a time).

@@ -223,6 +223,7 @@ void VisitFields(MatcherOptions& o, F&& f) {
         .In(s)
         .Unit("px")
         .Range(Between(1, kMaxSampleStep))
+        .AsVersion1(1.0)
         .Help("sapmvs: largest spacing of the samples scoring a window larger than --wsize (1 = "
               "every pixel)"));
   f(Field(o.ncc_sigma_color, "ncc_sigma_color")
@@ -236,6 +237,7 @@ void VisitFields(MatcherOptions& o, F&& f) {
         .Flag("--emit-min-weight")
         .In(s)
         .Range(Between(0, 1))
+        .AsVersion1(0.0)
         .Help("sapmvs: a window pixel gets a point only with at least this NCC sample weight (0 "
               "= every pixel)"));
   f(Field(o.refit_neighbours, "refit_neighbours")
@@ -243,16 +245,20 @@ void VisitFields(MatcherOptions& o, F&& f) {
         .In(s)
         .Unit("patches")
         .Range(Between(0, 64))
+        .AsVersion1(0)
         .Help("sapmvs: fit each patch plane to this many neighbouring centres (0 = off)"));
   f(Field(o.refit_tolerance, "refit_tolerance")
         .Flag("--refit-tolerance")
         .In(s)
         .Unit("footprints")
         .Range(Above(0))
+        .UnusedWhen(o.refit_neighbours == 0)
         .Help("sapmvs: a neighbouring centre within this of a patch plane confirms it"));
   f(Field(o.refill_cut, "refill_cut")
         .Flag("--refill-cut")
         .In(s)
+        .AsVersion1(false)
+        .UnusedWhen(o.refit_neighbours == 0)
         .Help("sapmvs: propagate again into the pixels the plane refit cut (more coverage, "
               "more time)"));
   s = "Seeds and edges";

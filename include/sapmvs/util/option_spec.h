@@ -10,8 +10,17 @@
 // from the others. Conditions between fields (threshold_before <= threshold)
 // stay hand-written in the struct's Problem(), after the ranges, in the same
 // "what was expected (name = value)" form.
+//
+// A run resumes from its checkpoint only when the options it records equal
+// the new ones (run_checkpoint.h). A field added after version 1 of the
+// checkpoints says, with AsVersion1, the value at which it matches as
+// version 1 did; there it is not recorded, so version-1 runs still resume.
+// A field without effect at the others' values (a setting of a stage that
+// another field turns off) says so with UnusedWhen, and is not recorded
+// either: its value cannot change what is matched.
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -81,6 +90,11 @@ struct OptionField {
   const char* rule = "";
   OptionRange range;
   FlagStyle style = FlagStyle::kValue;
+  // The value that matches as version 1 of the checkpoints (before the field
+  // existed) did; none for the fields version 1 had.
+  std::optional<std::remove_const_t<T>> as_version1;
+  // No effect at the values of the struct VisitFields was given.
+  bool unused = false;
 
   OptionField& Flag(const char* f) { return flag = f, *this; }
   OptionField& Unit(const char* u) { return unit = u, *this; }
@@ -89,6 +103,8 @@ struct OptionField {
   OptionField& Rule(const char* r) { return rule = r, *this; }
   OptionField& Range(OptionRange r) { return range = r, *this; }
   OptionField& Style(FlagStyle s) { return style = s, *this; }
+  OptionField& AsVersion1(const std::remove_const_t<T>& v) { return as_version1 = v, *this; }
+  OptionField& UnusedWhen(bool u) { return unused = u, *this; }
 };
 template <class T>
 OptionField<T> Field(T& value, const char* name) {
