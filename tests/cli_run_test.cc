@@ -72,7 +72,7 @@ TEST(CliRunHelp, ShowsSectionsAndExamples) {
                                                         {"Output and resume:", "--restart"},
                                                         {"Matching:", "--level"},
                                                         {"Device:", "--device"},
-                                                        {"Seeds and edges:", "--no-edges"},
+                                                        {"Seeds and edges:", "--edges"},
                                                         {"Propagation:", "--max-wave"},
                                                         {"Filter:", "--min-cluster"},
                                                         {"Grouping:", "--memory-budget"},

@@ -177,7 +177,7 @@ TEST(OptionSpec, FlagsWriteTheirFields) {
   cli::AddOptionFlags(&app, &o);
   cli::AddOptionFlags(&app, &o.dsm);
   app.parse(
-      "--mode pmvs --level 2 --threshold 0.8 --adaptive-sizes 15,7 --no-edges --canny-low 20 "
+      "--mode pmvs --level 2 --threshold 0.8 --adaptive-sizes 15,7 --edges --canny-low 20 "
       "--strategy footprint --memory-budget 512M --tile-size 0.5 --tile-views 3 "
       "--las-version 1.4 --restart --dsm-fill 2 --device gpu",
       false);
@@ -185,7 +185,7 @@ TEST(OptionSpec, FlagsWriteTheirFields) {
   EXPECT_EQ(o.matcher.level, 2);
   EXPECT_EQ(o.matcher.threshold, 0.8);
   EXPECT_EQ(o.matcher.adaptive_sizes, (std::vector<int>{15, 7}));
-  EXPECT_FALSE(o.matcher.use_edges);
+  EXPECT_TRUE(o.matcher.use_edges);
   EXPECT_EQ(o.matcher.canny_low, 20);
   EXPECT_EQ(o.matcher.canny_high, MatcherOptions{}.canny_high);
   EXPECT_EQ(o.grouping.strategy, GroupingStrategy::kFootprint);
@@ -268,6 +268,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
     "neighbour_radius": 4.0, "min_neighbours": 4, "plane_tolerance": 0.5,
     "plane_sigmas": 1.5, "min_cluster_size": 30})");
   MatcherOptions v1;
+  v1.use_edges = true;
   v1.emit_min_weight = 0;
   v1.refit_neighbours = 0;
   v1.refit_tolerance = 2;  // unused without the refit, so not recorded
@@ -304,7 +305,7 @@ TEST(OptionsReference, DocsAreCurrent) {
 TEST(OptionsReference, ListsEveryFlagOnce) {
   const std::string doc = OptionsReference();
   for (const char* flag : {"`--level`", "`--canny-low`", "`--tile-size`", "`--memory-budget`",
-                           "`--merge-radius`", "`--dsm-fill`", "`--no-edges`"}) {
+                           "`--merge-radius`", "`--dsm-fill`", "`--edges`"}) {
     const size_t at = doc.find(flag);
     EXPECT_NE(at, std::string::npos) << flag;
     EXPECT_EQ(doc.find(flag, at + 1), std::string::npos) << flag;

@@ -41,11 +41,7 @@ CLI::Option* AddOptionFlag(CLI::App* cmd, const OptionField<T>& f) {
   const std::string flag = f.flag;
   CLI::Option* opt = nullptr;
   if constexpr (std::is_same_v<T, bool>) {
-    if (f.style == FlagStyle::kNegated)
-      opt = cmd->add_flag_callback(
-          flag, [v] { *v = false; }, f.help);
-    else
-      opt = cmd->add_flag(flag, *v, f.help);
+    opt = cmd->add_flag(flag, *v, f.help);
   } else if constexpr (std::is_enum_v<T>) {
     // The enum's own parser names the bad value and the expected ones.
     opt = cmd->add_option_function<std::string>(

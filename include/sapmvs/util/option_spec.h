@@ -73,7 +73,6 @@ inline OptionRange Interval(double lo, double hi, bool lo_open, bool hi_open) {
 // How a field's flag is written on the command line.
 enum class FlagStyle {
   kValue,     // --flag VALUE (a bool: --flag alone sets it)
-  kNegated,   // bool: --flag alone sets it false (--no-edges)
   kList,      // comma-separated list
   kByteSize,  // 8G, 512M, ... (ParseByteSize)
 };
