@@ -8,6 +8,12 @@
 //   versus_pmvs2 BLOCK [--out DIR] [--level 1] [--threads N] [--truth DSM]
 //                [--modes sapmvs,pmvs] [--max-images N] [--markdown FILE]
 //                [--pmvs2 PATH] [--sapmvs PATH] [--exported PMVS_DIR]
+//                [--pmvs2-cloud PLY] [--run-flags "FLAGS"]
+//
+// --pmvs2-cloud compares with the cloud of an earlier PMVS2 run on the same
+// folder (models/option.ply) instead of running PMVS2 again, to try sapmvs
+// flags (--run-flags) against it; that row has no times. A claim of speed
+// needs PMVS2 run in the same benchmark run.
 //
 // PMVS2 is not part of this repository. It is looked for under the build
 // folder (build/anchors/, built by hand there), else $SAPMVS_PMVS2; without
@@ -54,6 +60,7 @@ namespace {
 struct Row {
   std::string name;  // "PMVS2" or "sapmvs --mode M"
   ChildUsage usage;
+  bool timed = true;                                 // false: a cloud of an earlier run
   PointCloud cloud;                                  // world frame
   std::optional<double> from_pmvs2[2], to_pmvs2[2];  // at 1 and 2 GSD
   // With truth: of PMVS2's points within 1 GSD of the true surface, the share
@@ -199,11 +206,15 @@ std::string Table(const std::vector<Row>& rows, bool with_truth) {
     << "\n";
   for (const Row& r : rows) {
     const ChildUsage& u = r.usage;
-    t << "| " << r.name << " | " << Fixed(u.wall_seconds, 1) << " | " << Fixed(u.cpu_seconds, 1)
-      << " | " << Fixed(u.cpu_seconds / std::max(u.wall_seconds, 1e-9), 2) << " | "
-      << Fixed(u.peak_rss_mib, 0) << " | " << r.cloud.points.size() << " | "
-      << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1]) << " | " << Share(r.to_pmvs2[0])
-      << " | " << Share(r.to_pmvs2[1]) << " |";
+    if (r.timed) {
+      t << "| " << r.name << " | " << Fixed(u.wall_seconds, 1) << " | " << Fixed(u.cpu_seconds, 1)
+        << " | " << Fixed(u.cpu_seconds / std::max(u.wall_seconds, 1e-9), 2) << " | "
+        << Fixed(u.peak_rss_mib, 0) << " | ";
+    } else {
+      t << "| " << r.name << " | – | – | – | – | ";
+    }
+    t << r.cloud.points.size() << " | " << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1])
+      << " | " << Share(r.to_pmvs2[0]) << " | " << Share(r.to_pmvs2[1]) << " |";
     if (with_truth) {
       t << " " << Share(r.right_from_pmvs2) << " |";
       if (r.truth) {
@@ -224,7 +235,7 @@ std::string Table(const std::vector<Row>& rows, bool with_truth) {
 int main(int argc, char** argv) {
   CLI::App app("sapmvs against PMVS2 on the same exported images, in one run");
   std::string block_path, out_dir = "/tmp/versus_pmvs2", truth_path, markdown_path;
-  std::string pmvs2_path, sapmvs_path, exported_dir;
+  std::string pmvs2_path, sapmvs_path, exported_dir, pmvs2_cloud, run_flags;
   int level = 1, max_images = 0;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::vector<std::string> modes = {"sapmvs", "pmvs"};
@@ -244,6 +255,12 @@ int main(int argc, char** argv) {
   app.add_option("--exported", exported_dir,
                  "Use this PMVS folder of BLOCK instead of exporting one (its option "
                  "file gets --level and --threads; PMVS2 writes its models/)");
+  app.add_option("--pmvs2-cloud", pmvs2_cloud,
+                 "Compare with this cloud of an earlier PMVS2 run on the same folder "
+                 "(models/option.ply) instead of running PMVS2; its row has no times")
+      ->check(CLI::ExistingFile);
+  app.add_option("--run-flags", run_flags,
+                 "More flags for each `sapmvs run`, in one argument (\"--refill-cut --no-edges\")");
   bool shift_pyramid = false;
   app.add_flag("--shift-pmvs2-pyramid", shift_pyramid,
                "Give PMVS2 matrices shifted by (2^level - 1)/2 px, undoing its pyramid's offset "
@@ -287,7 +304,14 @@ int main(int argc, char** argv) {
     const double gsd_level = std::ldexp(gsd, level);
 
     std::vector<Row> rows;
-    if (pmvs2.empty()) {
+    if (!pmvs2_cloud.empty()) {
+      Row r;
+      r.name = "PMVS2 (" + pmvs2_cloud + ", earlier run)";
+      r.timed = false;
+      r.cloud = ReadPly(pmvs2_cloud);
+      Translate(&r.cloud, origin);
+      rows.push_back(std::move(r));
+    } else if (pmvs2.empty()) {
       std::cout << "PMVS2 not built: skipped\n";
     } else {
       SetPmvsOptions(pmvs / "option", level, threads);
@@ -316,12 +340,15 @@ int main(int argc, char** argv) {
                       "--mode", mode, "--restart", "-q"},
                      {{"POCL_CPU_MAX_CU_NUM", std::to_string(threads)}},
                      logs / ("run_" + mode + ".log")};
+      std::istringstream extra(run_flags);
+      for (std::string flag; extra >> flag;) c.argv.push_back(flag);
+      if (!run_flags.empty()) r.name += " " + run_flags;
       r.usage = Step(c, &commands);
       r.cloud = ReadPly(run / "cloud.ply");
       rows.push_back(std::move(r));
     }
 
-    const bool have_pmvs2 = !pmvs2.empty();
+    const bool have_pmvs2 = !pmvs2.empty() || !pmvs2_cloud.empty();
     std::optional<Truth> truth;
     if (!truth_path.empty()) truth = ReadTruth(truth_path);
     for (Row& r : rows) {
@@ -363,6 +390,8 @@ int main(int argc, char** argv) {
     if (truth) md << "; truth " << truth_path << " (within 1 full-resolution GSD)";
     md << ".\n\n" << Table(rows, truth.has_value()) << "\n";
     if (!have_pmvs2) md << "PMVS2 not built: skipped.\n\n";
+    if (!pmvs2_cloud.empty())
+      md << "PMVS2's cloud from an earlier run: its times are not shown.\n\n";
     md << "Commands (cwd " << fs::current_path().string() << "):\n\n```sh\n";
     for (const std::string& c : commands) md << c << "\n";
     md << "```\n\n";
