@@ -348,6 +348,28 @@ TEST_F(MatchGroupTest, MatchedEdgesLieOnTheSurfaceAndBarriersKeepTheFloors) {
   ExpectMeetsFloors(m, {30000, 0.85, 0.45, 0.58});
 }
 
+// A patch is tried at a larger size only where its plane already scores
+// grow_threshold there: the higher the bar, the fewer large patches, none at
+// a bar no noisy window reaches; 0 is PMVS's threshold_before, the most.
+TEST_F(MatchGroupTest, LargerSizesAreTriedWhereThePlaneAlreadyScoresTheGrowThreshold) {
+  MatcherOptions o = Options(MatchMode::kSapmvs);
+  auto large = [](const MatchStats& s, int window) {
+    long n = 0;
+    for (const auto& [size, count] : s.accepted_by_size) n += size > window ? count : 0;
+    return n;
+  };
+  std::vector<long> counts;
+  for (const double bar : {0.0, 0.9, 1.0}) {
+    o.grow_threshold = bar;
+    const Measured m = MatchAndCheck(o);
+    counts.push_back(large(m.result.stats, o.window_size));
+    std::printf("[ measured ] grow_threshold %.1f: %ld large patches\n", bar, counts.back());
+  }
+  EXPECT_GT(counts[0], counts[1]);
+  EXPECT_GT(counts[1], 0);
+  EXPECT_EQ(counts[2], 0);
+}
+
 // PMVS's expand-filter loop: the passes after the first grow the surviving
 // patches into the cells the filter freed, which covers more of the ground.
 TEST_F(MatchGroupTest, LaterPassesGrowIntoTheCellsTheFilterFreed) {

@@ -269,6 +269,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
     "plane_sigmas": 1.5, "min_cluster_size": 30})");
   MatcherOptions v1;
   v1.use_edges = true;
+  v1.grow_threshold = 0;
   v1.emit_min_weight = 0;
   v1.refit_neighbours = 0;
   v1.refit_tolerance = 2;  // unused without the refit, so not recorded

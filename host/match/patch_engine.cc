@@ -180,12 +180,15 @@ std::vector<int> PatchEngine::WorthPolishing(
   // coverage with them, 30.7 % and 35.7 % without; group 1 (6 images) 27.6
   // / 32.1 % -> 37.6 / 41.5 %; `small` (25 degrees) unchanged.
   //
-  // PMVS's rule before optimising, applied at each larger size too: the
-  // unpolished plane must already score threshold_before in enough views,
-  // over the whole window and in each border sub-window. Most large patches
-  // fail the border test after polishing (on `small`, two thirds of those
-  // that pass over the whole window at 21 x 21), and a plane that scores
-  // under 0.4 at its border is rarely rescued by a polish worth 49 scores.
+  // PMVS's rule before optimising, applied at each larger size with a
+  // stricter bar (grow_threshold, matcher_options.h): the unpolished plane
+  // must already score it in enough views, over the whole window and in each
+  // border sub-window. Most large patches failed the border test after
+  // polishing at threshold_before (on `small`, two thirds of those that pass
+  // over the whole window at 21 x 21), and those that passed after a rescue
+  // by the polish were the least accurate.
+  const double bar =
+      options_.grow_threshold > 0 ? options_.grow_threshold : options_.threshold_before;
   const int need = options_.min_image_num - 1;
   std::vector<NccPatch> patches;
   std::vector<NccPair> pairs;
@@ -209,7 +212,7 @@ std::vector<int> PatchEngine::WorthPolishing(
     std::vector<int> kept;
     for (const int v : results[i]->views) {
       const float x = scores[pair_index++];
-      if (std::isfinite(x) && x >= options_.threshold_before) kept.push_back(v);
+      if (std::isfinite(x) && x >= bar) kept.push_back(v);
     }
     if (static_cast<int>(kept.size()) < need) {
       rejected->push_back(i);
@@ -223,7 +226,7 @@ std::vector<int> PatchEngine::WorthPolishing(
     const AcceptedPatch& a = *results[scored[j]];
     planes.push_back(LargePlane{a.center, a.normal, a.ref, &scored_views[j]});
   }
-  const std::vector<bool> fit = CornersFit(size, planes, options_.threshold_before);
+  const std::vector<bool> fit = CornersFit(size, planes, bar);
   std::vector<int> worth;
   views->clear();
   for (size_t j = 0; j < scored.size(); ++j) {
