@@ -35,6 +35,12 @@
 // the in-plane grid axes are undefined. Host twin: kNccMinAxisLength.
 #define NCC_MIN_AXIS_LENGTH 1e-3f
 
+// Smallest share of its fronto-parallel length in the reference image that a
+// grid axis may keep (cos of 84 degrees): a plane seen that obliquely would
+// need grid steps ten times as long on it as seen face-on, and is rejected.
+// Host twin: kNccMinForeshortening.
+#define NCC_MIN_FORESHORTENING 0.1f
+
 // One image's camera (host: NccCamera, 96 bytes).
 typedef struct {
   float4 p0, p1, p2;  // Rows of the 3x4 projection matrix K [R | t], local frame.
@@ -62,19 +68,23 @@ float sample_image(__global const float* images, __global const int4* table, int
 }
 
 // The grid axes of the patch (c, n) seen from `ref`: one sample step along
-// the grid's columns (dx) and rows (dy). The step is SAMPLE_STEP footprints
-// of one reference pixel at c, depth / f (the third row of K [R | t] gives
-// the depth along the optical axis); dx follows the reference x axis
+// the grid's columns (dx) and rows (dy). dx follows the reference x axis
 // projected onto the plane, dy the in-plane perpendicular turned towards the
 // reference y axis, so the grid follows the reference image's rows and
-// columns (as PMVS's getPAxes). False when c is not in front of the
-// reference or the plane (nearly) contains its x axis.
+// columns; each is scaled so that one step projects to SAMPLE_STEP reference
+// pixels at c (the Jacobian of the projection there), as PMVS's getPAxes
+// does. The window then covers the reference pixels that the patch's points
+// are written for whatever the plane's tilt: a step of depth / f on the
+// plane squeezed an oblique plane's window to a few pixels along its slope
+// (Herz-Jesu-P8's ground in front of the façade). False when c is not in
+// front of the reference, the plane (nearly) contains its x axis, or an axis
+// is foreshortened below NCC_MIN_FORESHORTENING.
 bool patch_axes(const NccCamera ref, float3 c, float3 n, float3* dx, float3* dy) {
-  const float depth = dot(ref.p2, (float4)(c, 1.0f));
+  const float4 o = (float4)(c, 1.0f);
+  const float depth = dot(ref.p2, o);
   if (!(depth > 0.0f)) {
     return false;
   }
-  const float step = SAMPLE_STEP * (depth / ref.center.w);
   const float3 x_proj = ref.x_axis.xyz - dot(ref.x_axis.xyz, n) * n;
   const float x_length = length(x_proj);
   if (!(x_length >= NCC_MIN_AXIS_LENGTH)) {
@@ -85,8 +95,21 @@ bool patch_axes(const NccCamera ref, float3 c, float3 n, float3* dx, float3* dy)
   if (dot(y_dir, ref.y_axis.xyz) < 0.0f) {
     y_dir = -y_dir;
   }
-  *dx = step * x_dir;
-  *dy = step * y_dir;
+  // Reference pixels per unit length along each axis: (p0 - u p2, p1 - v p2)
+  // applied to the direction, over the depth.
+  const float u = dot(ref.p0, o) / depth;
+  const float v = dot(ref.p1, o) / depth;
+  const float3 ju = ref.p0.xyz - u * ref.p2.xyz;
+  const float3 jv = ref.p1.xyz - v * ref.p2.xyz;
+  const float x_pixels = length((float2)(dot(ju, x_dir), dot(jv, x_dir))) / depth;
+  const float y_pixels = length((float2)(dot(ju, y_dir), dot(jv, y_dir))) / depth;
+  // Fronto-parallel, both are f / depth.
+  const float min_pixels = NCC_MIN_FORESHORTENING * (ref.center.w / depth);
+  if (!(x_pixels >= min_pixels && y_pixels >= min_pixels)) {
+    return false;
+  }
+  *dx = (SAMPLE_STEP / x_pixels) * x_dir;
+  *dy = (SAMPLE_STEP / y_pixels) * y_dir;
   return true;
 }
 

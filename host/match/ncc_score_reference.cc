@@ -16,6 +16,8 @@ namespace {
 // Twin of NCC_MIN_AXIS_LENGTH in kernels/ncc_score.cl: a kernel-internal
 // geometric guard, not a tunable, so it is not passed as -D.
 constexpr double kNccMinAxisLength = 1e-3;
+// Twin of NCC_MIN_FORESHORTENING.
+constexpr double kNccMinForeshortening = 0.1;
 constexpr size_t kMaxSamples = static_cast<size_t>(kMaxPatchSize) * kMaxPatchSize;
 
 // Signed distance of (x, y) to the edge of [0, w - 1] x [0, h - 1]: positive
@@ -52,21 +54,30 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
   const Eigen::Vector3d n = Xyz(patch.normal);
   const double depth = Xyzw(ref.p[2]).dot(c.homogeneous());
   if (!(depth > 0.0)) return nan;
-  // The kernel's SAMPLE_STEP is a float literal.
-  const double step =
-      static_cast<double>(static_cast<float>(sample_step)) * (depth / ref.center.s[3]);
-  // Same grid axes as the kernel (see ncc_score.cl).
+  // Same grid axes as the kernel (see patch_axes in ncc.cl).
   const Eigen::Vector3d x_proj = Xyz(ref.x_axis) - Xyz(ref.x_axis).dot(n) * n;
   if (!(x_proj.norm() >= kNccMinAxisLength)) return nan;
   const Eigen::Vector3d x_dir = x_proj.normalized();
   Eigen::Vector3d y_dir = n.cross(x_dir);
   if (y_dir.dot(Xyz(ref.y_axis)) < 0.0) y_dir = -y_dir;
+  const double u0 = Xyzw(ref.p[0]).dot(c.homogeneous()) / depth;
+  const double v0 = Xyzw(ref.p[1]).dot(c.homogeneous()) / depth;
+  const Eigen::Vector3d ju = Xyz(ref.p[0]) - u0 * Xyz(ref.p[2]);
+  const Eigen::Vector3d jv = Xyz(ref.p[1]) - v0 * Xyz(ref.p[2]);
+  const double x_pixels = std::hypot(ju.dot(x_dir), jv.dot(x_dir)) / depth;
+  const double y_pixels = std::hypot(ju.dot(y_dir), jv.dot(y_dir)) / depth;
+  const double min_pixels = kNccMinForeshortening * (ref.center.s[3] / depth);
+  if (!(x_pixels >= min_pixels && y_pixels >= min_pixels)) return nan;
+  // The kernel's SAMPLE_STEP is a float literal.
+  const double step = static_cast<float>(sample_step);
+  const Eigen::Vector3d step_x = (step / x_pixels) * x_dir;
+  const Eigen::Vector3d step_y = (step / y_pixels) * y_dir;
 
   bool valid = true;
   double margin = std::numeric_limits<double>::infinity();
   for (int r = 0; r < patch_size && valid; ++r) {
     for (int col = 0; col < patch_size && valid; ++col) {
-      const Eigen::Vector3d x = c + ((col - half) * step) * x_dir + ((r - half) * step) * y_dir;
+      const Eigen::Vector3d x = c + (col - half) * step_x + (r - half) * step_y;
       for (int v = 0; v < 2 && valid; ++v) {
         const NccCamera& camera = group.cameras[views[v]];
         const FloatImageView& image = group.images[views[v]];
