@@ -14,6 +14,7 @@
 
 #include "cl_test_fixture.h"
 #include "plane_scene.h"
+#include "sapmvs/block/rotation.h"
 #include "sapmvs/util/kernel_limits.h"
 #include "test_util.h"
 
@@ -306,6 +307,51 @@ TEST_F(NccScorerTest, FlatImageAndBehindCameraGiveNaN) {
   for (size_t i = 1; i < pairs.size(); ++i) {
     EXPECT_TRUE(std::isnan(scores[i])) << "pair " << i;
     EXPECT_TRUE(std::isnan(expected[i])) << "pair " << i;
+  }
+}
+
+// The grid spans the same reference pixels however the plane is tilted (as
+// PMVS2's getPAxes): a patch 5 px below the top border, its plane turned
+// about the reference x axis away from facing the camera, keeps its top
+// samples 3 rows above its centre, 2 px from the border (the reference scored
+// against itself, so the margin is the reference's). A grid stepping a
+// face-on footprint along the plane would keep them at 3 cos(tilt) rows: at
+// 70 degrees a margin near 4 px. Beyond 84 degrees the plane is not scored.
+TEST_F(NccScorerTest, ObliquePlaneKeepsItsReferenceWindow) {
+  const PlaneScene scene = MakePlaneScene(2, 161, 123, 91);
+  const Camera& ref = scene.cameras[0];
+  const Eigen::Vector3d center = GroundAt(ref, Eigen::Vector2d(80, 5));
+  const Eigen::Vector3d facing = (ref.center() - center).normalized();
+  const Eigen::Vector3d ref_x = ref.rotation().row(0).transpose();
+  const std::vector<double> tilts = {0.0, 40.0, 70.0, 80.0, 86.0};
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  for (const double tilt : tilts) {
+    const Eigen::Vector3d normal =
+        Eigen::AngleAxisd(ToRadians(tilt, AngleUnit::kDegree), ref_x) * facing;
+    pairs.push_back({static_cast<int>(patches.size()), 0});
+    patches.push_back(MakeNccPatch(center, normal, 0));
+  }
+  std::vector<double> margin;
+  const std::vector<double> expected =
+      NccScoreReference(scene.group, patches, pairs, kDefaultPatchSize, &margin);
+  NccScorer scorer(context());
+  scorer.SetGroup(scene.group);
+  const std::vector<float> scores = scorer.Score(patches, pairs);
+  for (size_t i = 0; i < tilts.size(); ++i) {
+    std::printf("[ NCC      ] tilt %.0f deg: margin %.3f px, score %.3f\n", tilts[i], margin[i],
+                scores[i]);
+    EXPECT_TRUE(NearAbsRel(scores[i], expected[i], kAbsTol, kRelTol)) << "tilt " << tilts[i];
+    if (tilts[i] > 84.0) {
+      EXPECT_TRUE(std::isnan(expected[i])) << "tilt " << tilts[i];
+      continue;
+    }
+    ASSERT_FALSE(std::isnan(expected[i])) << "tilt " << tilts[i];
+    EXPECT_NEAR(expected[i], 1.0, 1e-9) << "tilt " << tilts[i];
+    // Perspective bends the tilted plane's rows (measured: margins 1.98,
+    // 1.91, 1.79 and 1.61 px); a face-on footprint step would leave 2.0,
+    // 2.7, 4.0 and 4.5.
+    EXPECT_NEAR(margin[i], 2.0, 0.5) << "tilt " << tilts[i];
   }
 }
 
