@@ -107,6 +107,32 @@ TEST_F(FreeSpaceTest, AWeakerGroundPointDoesNotOutvoteABetterSupportedOne) {
   EXPECT_TRUE(VisibilityFilter(group, options, p.points, p.patches)[f]);
 }
 
+// A steep plane, its normal 81 degrees from the nadir images' lines of sight
+// (Herz-Jesu-P8's ground from its cameras), sampled every 0.3 m across
+// (0.9 px): one 2 px cell of an image holds points 1.9 m apart in depth along
+// the slope, almost 6 face-on footprints. Counted along the slope, the depth
+// tolerance keeps them all; counted face-on (3 footprints, 1 m) it hid the
+// deeper points of every cell behind the nearer ones, half the plane.
+TEST(VisibilityFilter, ASurfaceSeenObliquelyIsNotHiddenByItself) {
+  const MatchGroupData group = NadirGroup({{0, -10, 100}, {0, 0, 100}, {0, 10, 100}});
+  const double tilt = 81.0 * std::acos(-1.0) / 180.0;
+  const Eigen::Vector3d normal(std::sin(tilt), 0, std::cos(tilt));
+  Points p;
+  for (int r = 0; r < 21; ++r) {
+    for (int c = 0; c < 11; ++c) {
+      const double x = -1.5 + 0.3 * c;
+      const int i = p.Add(Eigen::Vector3d(x, -3 + 0.3 * r, -x * std::tan(tilt)), 1, {0, 2}, 0.95f);
+      p.patches[p.points[i].patch].normal = normal;
+    }
+  }
+  MatcherOptions options;
+  const std::vector<bool> keep = VisibilityFilter(group, options, p.points, p.patches);
+  long kept = 0;
+  for (const bool k : keep) kept += k;
+  std::printf("[ filter   ] plane seen at 81 degrees: %ld of %zu points kept\n", kept, keep.size());
+  EXPECT_EQ(kept, static_cast<long>(keep.size()));
+}
+
 // A flat grid of points under images 0-2, every other one from a weak patch.
 Points GridWithWeakPatches(int* weak) {
   Points p;

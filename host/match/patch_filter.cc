@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "match/footprint.h"
 #include "sapmvs/util/error.h"
 
 namespace sapmvs {
@@ -18,10 +19,6 @@ namespace {
 // working pixel (sapmvs) 16 reach about 2.3 pixels; with one per 2x2 cell
 // (pmvs) about 4.5.
 constexpr int kNeighbours = 16;
-
-double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
-  return camera.Depth(x) / camera.intrinsics().MeanFocal();
-}
 
 int Find(std::vector<int>& parent, int i) {
   while (parent[i] != i) {
@@ -54,9 +51,12 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     b.front.assign(size, 0);
     b.back.assign(size, 0);
   }
-  // Cell, depth and depth tolerance of point x in image v; false when x is
-  // behind the camera or off the image.
-  auto locate = [&](int v, const Eigen::Vector3d& x, size_t* cell, double* d, double* tol) {
+  // Cell, depth and depth tolerance of point x on a plane of normal nx in
+  // image v; false when x is behind the camera or off the image. The
+  // tolerance is counted in footprints along the plane's slope: a surface
+  // seen obliquely spreads its depths over a cell that much further.
+  auto locate = [&](int v, const Eigen::Vector3d& x, const Eigen::Vector3d& nx, size_t* cell,
+                    double* d, double* tol) {
     const Camera& cam = group.images[v].camera;
     *d = cam.Depth(x);
     if (!(*d > 0)) return false;
@@ -65,7 +65,7 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     const int cy = static_cast<int>(std::floor((uv.y() + 0.5) / cs));
     if (cx < 0 || cy < 0 || cx >= buffers[v].cols || cy >= buffers[v].rows) return false;
     *cell = static_cast<size_t>(cy) * buffers[v].cols + cx;
-    *tol = options.depth_tolerance * *d / cam.intrinsics().MeanFocal();
+    *tol = options.depth_tolerance * SlopeFootprint(cam, x, nx);
     return true;
   };
   // (image, cell, depth) of each point in each image it was matched in.
@@ -74,7 +74,7 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     auto visit = [&](int v) {
       size_t cell = 0;
       double d = 0, tol = 0;
-      if (locate(v, points[i].x, &cell, &d, &tol)) f(v, cell, d, tol);
+      if (locate(v, points[i].x, patch.normal, &cell, &d, &tol)) f(v, cell, d, tol);
     };
     visit(patch.ref);
     for (const int v : patch.views) visit(v);
@@ -123,7 +123,8 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
       for (int v = 0; v < n; ++v) {
         size_t cell = 0;
         double d = 0, tol = 0;
-        if (own[v] || !locate(v, points[i].x, &cell, &d, &tol)) continue;
+        if (own[v] || !locate(v, points[i].x, patches[points[i].patch].normal, &cell, &d, &tol))
+          continue;
         if (d < buffers[v].min_depth[cell] - tol) violated += buffers[v].front[cell];
       }
     }
@@ -159,13 +160,18 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   flann::Matrix<float> data(xyz.data(), alive.size(), 3);
   flann::Index<flann::L2<float>> index(data, flann::KDTreeSingleIndexParams(10));
   index.buildIndex();
-  // Each point's footprint in its reference image: its neighbour radius
-  // (neighbour_radius of them) and the unit of the plane distances below.
-  std::vector<double> footprint(alive.size());
+  // Each point's footprint in its reference image, the unit of the plane
+  // distances below, and its neighbour radius: neighbour_radius footprints
+  // along its plane's slope, so that a surface seen obliquely, whose points
+  // lie further apart, keeps as many neighbours as one seen face-on.
+  std::vector<double> footprint(alive.size()), radius(alive.size());
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
-    footprint[a] = Footprint(group.images[patches[p.patch].ref].camera, p.x);
+    const AcceptedPatch& patch = patches[p.patch];
+    const Camera& camera = group.images[patch.ref].camera;
+    footprint[a] = Footprint(camera, p.x);
+    radius[a] = options.neighbour_radius * SlopeFootprint(camera, p.x, patch.normal);
   }
   // nn[a * k + j]: the j-th nearest neighbour of point a when it lies within
   // a's radius and is not a itself, else -1. Searched in chunks, so that
@@ -190,10 +196,10 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       index.knnSearch(queries, nn_m, nd_m, k, params);
       for (size_t r = 0; r < rows; ++r) {
         const size_t a = first + r;
-        const float radius = static_cast<float>(options.neighbour_radius * footprint[a]);
+        const float r2 = static_cast<float>(radius[a] * radius[a]);
         for (int j = 0; j < k; ++j) {
           const size_t b = chunk_nn[r * k + j];
-          if (b == a || chunk_nd[r * k + j] > radius * radius) continue;
+          if (b == a || chunk_nd[r * k + j] > r2) continue;
           nn[a * k + j] = static_cast<int32_t>(b);
         }
       }

@@ -7,6 +7,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "match/footprint.h"
+
 namespace sapmvs {
 namespace {
 
@@ -47,8 +49,9 @@ std::vector<Eigen::Vector3d> FitPatchNormals(const MatchGroupData& group,
   for (size_t a = 0; a < ids.size(); ++a) {
     const AcceptedPatch& pa = patches[ids[a]];
     const Camera& cam = group.images[pa.ref].camera;
-    const double fp = cam.Depth(pa.center) / cam.intrinsics().MeanFocal();
-    const double reach = (pa.size + 4) * fp;
+    const double fp = Footprint(cam, pa.center);
+    // Along the plane's slope: a window's reach on a surface seen obliquely.
+    const double reach = (pa.size + 4) * SlopeFootprint(cam, pa.center, pa.normal);
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     int support = 0;
     for (int j = 0; j < k; ++j) {

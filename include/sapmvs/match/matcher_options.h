@@ -144,9 +144,13 @@ struct MatcherOptions {
   // texture): about 0.98 on the simulator's, 0.89 on NGI's scans; a fixed
   // `threshold` (0.7, the floor) cannot be both.
   double score_fence = 3.0;
-  // Filtering: depth agreement tolerance, in pixel footprints.
+  // Depth agreement tolerance, in pixel footprints: in the visibility filter
+  // along the point's plane's slope (face-on footprints over the cosine of
+  // the angle to the line of sight), in propagation and the edge barriers
+  // off a patch's plane.
   double depth_tolerance = 3.0;
-  // Neighbourhood test: neighbours within this many footprints of a point.
+  // Neighbourhood test: neighbours within this many footprints of a point,
+  // along its plane's slope.
   double neighbour_radius = 4.0;
   // A point needs this many neighbours, and must lie within the plane
   // tolerance of the plane they fit; a patch's plane must pass within it of
