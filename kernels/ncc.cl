@@ -38,7 +38,7 @@
 // Smallest share of its fronto-parallel length in the reference image that a
 // grid axis may keep (cos of 84 degrees): a plane seen that obliquely would
 // need grid steps ten times as long on it as seen face-on, and is rejected.
-// Host twin: kNccMinForeshortening.
+// Host twin: kMinForeshortening (host/match/footprint.h).
 #define NCC_MIN_FORESHORTENING 0.1f
 
 // One image's camera (host: NccCamera, 96 bytes).

@@ -8,10 +8,11 @@
 
 namespace sapmvs {
 
-// The smallest cosine between a surface's normal and a line of sight that
-// SlopeFootprint divides by: the NCC grid does not score planes seen more
-// obliquely (NCC_MIN_FORESHORTENING in kernels/ncc.cl).
-inline constexpr double kMinSlopeCosine = 0.1;
+// Host twin of NCC_MIN_FORESHORTENING (kernels/ncc.cl): the smallest share
+// of its face-on length that a direction on a plane may keep in an image,
+// the cosine of 84 degrees. The NCC grid does not score planes seen more
+// obliquely, and SlopeFootprint divides by no smaller cosine.
+inline constexpr double kMinForeshortening = 0.1;
 
 // One pixel of `camera` at x, seen face-on: depth / f.
 inline double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
@@ -28,7 +29,7 @@ inline double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
 inline double SlopeFootprint(const Camera& camera, const Eigen::Vector3d& x,
                              const Eigen::Vector3d& n) {
   const double cosine = std::abs((camera.center() - x).normalized().dot(n));
-  return Footprint(camera, x) / std::max(cosine, kMinSlopeCosine);
+  return Footprint(camera, x) / std::max(cosine, kMinForeshortening);
 }
 
 }  // namespace sapmvs

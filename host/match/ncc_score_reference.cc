@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 
+#include "match/footprint.h"
 #include "sapmvs/util/error.h"
 
 namespace sapmvs {
@@ -16,8 +17,6 @@ namespace {
 // Twin of NCC_MIN_AXIS_LENGTH in kernels/ncc_score.cl: a kernel-internal
 // geometric guard, not a tunable, so it is not passed as -D.
 constexpr double kNccMinAxisLength = 1e-3;
-// Twin of NCC_MIN_FORESHORTENING.
-constexpr double kNccMinForeshortening = 0.1;
 constexpr size_t kMaxSamples = static_cast<size_t>(kMaxPatchSize) * kMaxPatchSize;
 
 // Signed distance of (x, y) to the edge of [0, w - 1] x [0, h - 1]: positive
@@ -66,7 +65,7 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
   const Eigen::Vector3d jv = Xyz(ref.p[1]) - v0 * Xyz(ref.p[2]);
   const double x_pixels = std::hypot(ju.dot(x_dir), jv.dot(x_dir)) / depth;
   const double y_pixels = std::hypot(ju.dot(y_dir), jv.dot(y_dir)) / depth;
-  const double min_pixels = kNccMinForeshortening * (ref.center.s[3] / depth);
+  const double min_pixels = kMinForeshortening * (ref.center.s[3] / depth);
   if (!(x_pixels >= min_pixels && y_pixels >= min_pixels)) return nan;
   // The kernel's SAMPLE_STEP is a float literal.
   const double step = static_cast<float>(sample_step);

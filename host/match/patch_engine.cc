@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "match/footprint.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
 
@@ -107,8 +108,7 @@ std::vector<float> PatchEngine::Score(const std::vector<NccPatch>& patches,
 bool PatchEngine::OnParentPlane(const PatchCandidate& candidate,
                                 const Eigen::Vector3d& center) const {
   if (!candidate.has_parent) return true;
-  const Camera& cam = group_.images[candidate.ref].camera;
-  const double footprint = cam.Depth(center) / cam.intrinsics().MeanFocal();
+  const double footprint = Footprint(group_.images[candidate.ref].camera, center);
   return std::abs(candidate.parent_normal.dot(center - candidate.parent_center)) <=
          options_.depth_tolerance * footprint;
 }

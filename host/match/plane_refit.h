@@ -29,10 +29,10 @@ inline constexpr int kUnfittedReach = 1;
 // centres of its options.refit_neighbours nearest patches that lie within
 // (size + 4) footprints along its plane's slope (SlopeFootprint: one window
 // and the propagation's step) and within options.refit_tolerance footprints
-// of p's own plane (so that a roof's patches do not tilt the ground's). Zero when fewer than 3 such
-// centres, when they lie along a line, or when the fitted plane faces the
-// reference more obliquely than view_angle_deg. All zero when
-// options.refit_neighbours is 0.
+// of p's own plane (so that a roof's patches do not tilt the ground's). Zero
+// when fewer than 3 such centres, when they lie along a line, or when the
+// fitted plane faces the reference more obliquely than view_angle_deg. All
+// zero when options.refit_neighbours is 0.
 std::vector<Eigen::Vector3d> FitPatchNormals(const MatchGroupData& group,
                                              const MatcherOptions& options,
                                              const std::vector<AcceptedPatch>& patches,

@@ -1,5 +1,6 @@
 #include "match/propagation.h"
 
+#include "match/footprint.h"
 #include "match/ncc_score_reference.h"
 #include "match/plane_refit.h"
 
@@ -102,8 +103,7 @@ bool Propagator::IsBarrier(int image, int x, int y, const AcceptedPatch& patch) 
   const auto found = edges_[image].points.find(y * edges_[image].matched.cols + x);
   if (found == edges_[image].points.end()) return false;
   const Eigen::Vector3d p = found->second.cast<double>();
-  const Camera& cam = group_.images[image].camera;
-  const double footprint = cam.Depth(patch.center) / cam.intrinsics().MeanFocal();
+  const double footprint = Footprint(group_.images[image].camera, patch.center);
   const double off_plane = std::abs(patch.normal.dot(p - patch.center));
   return off_plane > options_.depth_tolerance * footprint;
 }
