@@ -67,19 +67,14 @@ float sample_image(__global const float* images, __global const int4* table, int
   return bilinear_at(images + t.x, t.y, t.z, t.w, x, y);
 }
 
-// The grid axes of the patch (c, n) seen from `ref`: one sample step along
-// the grid's columns (dx) and rows (dy). dx follows the reference x axis
-// projected onto the plane, dy the in-plane perpendicular turned towards the
-// reference y axis, so the grid follows the reference image's rows and
-// columns; each is scaled so that one step projects to SAMPLE_STEP reference
-// pixels at c (the Jacobian of the projection there), as PMVS's getPAxes
-// does. The window then covers the reference pixels that the patch's points
-// are written for whatever the plane's tilt: a step of depth / f on the
-// plane squeezed an oblique plane's window to a few pixels along its slope
-// (Herz-Jesu-P8's ground in front of the façade). False when c is not in
-// front of the reference, the plane (nearly) contains its x axis, or an axis
-// is foreshortened below NCC_MIN_FORESHORTENING.
-bool patch_axes(const NccCamera ref, float3 c, float3 n, float3* dx, float3* dy) {
+// Whether the plane (c, n) can be scored from `ref`: c in front of it, the
+// plane not (nearly) containing its x axis, and neither in-plane axis (the
+// reference x axis projected onto the plane, and its in-plane perpendicular)
+// foreshortened below NCC_MIN_FORESHORTENING of its face-on length, measured
+// with the projection's Jacobian at c as PMVS's getPAxes scales its axes.
+// Seen that obliquely (beyond 84 degrees), one reference pixel would stretch
+// over ten face-on footprints of the plane.
+bool plane_seen(const NccCamera ref, float3 c, float3 n) {
   const float4 o = (float4)(c, 1.0f);
   const float depth = dot(ref.p2, o);
   if (!(depth > 0.0f)) {
@@ -91,10 +86,7 @@ bool patch_axes(const NccCamera ref, float3 c, float3 n, float3* dx, float3* dy)
     return false;
   }
   const float3 x_dir = x_proj / x_length;
-  float3 y_dir = cross(n, x_dir);
-  if (dot(y_dir, ref.y_axis.xyz) < 0.0f) {
-    y_dir = -y_dir;
-  }
+  const float3 y_dir = cross(n, x_dir);
   // Reference pixels per unit length along each axis: (p0 - u p2, p1 - v p2)
   // applied to the direction, over the depth.
   const float u = dot(ref.p0, o) / depth;
@@ -105,34 +97,91 @@ bool patch_axes(const NccCamera ref, float3 c, float3 n, float3* dx, float3* dy)
   const float y_pixels = length((float2)(dot(ju, y_dir), dot(jv, y_dir))) / depth;
   // Fronto-parallel, both are f / depth.
   const float min_pixels = NCC_MIN_FORESHORTENING * (ref.center.w / depth);
-  if (!(x_pixels >= min_pixels && y_pixels >= min_pixels)) {
+  return x_pixels >= min_pixels && y_pixels >= min_pixels;
+}
+
+// The reference window of a patch centred at c: the PATCH_SIZE x PATCH_SIZE
+// reference pixels around c's projection, SAMPLE_STEP apart along the
+// image's rows and columns, and the rays through them. These are the pixels
+// whose rays the host intersects with an accepted patch's plane to write its
+// points, so the window scored is the window written. It depends on c's
+// reference ray only, not on the plane: the refinement, which moves c along
+// that ray, samples and normalises it once per patch instead of once per
+// candidate and view.
+typedef struct {
+  float2 uv;      // c's projection: the centre sample.
+  float3 ray0;    // M^-1 (u, v, 1), M = K R the reference's left 3x3: the ray
+                  // to c over its depth, (c - C) / depth.
+  float3 ray_x;   // SAMPLE_STEP M^-1 (1, 0, 0): the ray's change per column.
+  float3 ray_y;   // SAMPLE_STEP M^-1 (0, 1, 0): its change per row.
+  float3 origin;  // C, the reference's projection centre.
+} ReferenceWindow;
+
+// False when c is not in front of the reference.
+bool reference_window(const NccCamera ref, float3 c, ReferenceWindow* win) {
+  const float4 o = (float4)(c, 1.0f);
+  const float depth = dot(ref.p2, o);
+  if (!(depth > 0.0f)) {
     return false;
   }
-  *dx = (SAMPLE_STEP / x_pixels) * x_dir;
-  *dy = (SAMPLE_STEP / y_pixels) * y_dir;
+  // The columns of M^-1 are the rows' cross products over det M.
+  const float3 m0 = ref.p0.xyz;
+  const float3 m1 = ref.p1.xyz;
+  const float3 m2 = ref.p2.xyz;
+  const float3 c12 = cross(m1, m2);
+  const float scale = SAMPLE_STEP / dot(m0, c12);
+  win->uv = (float2)(dot(ref.p0, o), dot(ref.p1, o)) / depth;
+  win->origin = ref.center.xyz;
+  win->ray0 = (c - win->origin) / depth;
+  win->ray_x = scale * c12;
+  win->ray_y = scale * cross(m2, m0);
   return true;
 }
 
-// The homogeneous projections of a patch grid into one camera. The grid lies
-// on a plane, so projection is linear in the grid indices: the sample at
-// offsets (r, col) from the centre projects to h0 + r hy + col hx. Three dot
-// products per camera then replace three per sample, which was a third of a
-// sample's arithmetic (bench_patch_refiner).
+// The reference sample (r, col), offsets from the centre; NaN outside the
+// image.
+float sample_reference(__global const float* images, __global const int4* table, int index,
+                       const ReferenceWindow win, float r, float col) {
+  return sample_image(images, table, index, win.uv.x + SAMPLE_STEP * col,
+                      win.uv.y + SAMPLE_STEP * r);
+}
+
+// The projections of a window's samples into one camera. Sample (r, col)
+// lies where its reference ray meets the patch plane and projects to
+// h0 + r hy + col hx (homogeneous): the plane-induced homography, linear in
+// the grid indices, so that three dot products per camera replace three per
+// sample.
 typedef struct {
-  float3 h0;  // P [c; 1]: the centre.
-  float3 hx;  // P [dx; 0]: one step along the grid's columns.
-  float3 hy;  // P [dy; 0]: one step along its rows.
+  float3 h0;  // The centre.
+  float3 hx;  // One step along the window's columns.
+  float3 hy;  // One step along its rows.
 } GridProjection;
 
-GridProjection project_grid(const NccCamera camera, float3 c, float3 dx, float3 dy) {
-  const float4 o = (float4)(c, 1.0f);
-  const float4 x = (float4)(dx, 0.0f);
-  const float4 y = (float4)(dy, 0.0f);
-  GridProjection g;
-  g.h0 = (float3)(dot(camera.p0, o), dot(camera.p1, o), dot(camera.p2, o));
-  g.hx = (float3)(dot(camera.p0, x), dot(camera.p1, x), dot(camera.p2, x));
-  g.hy = (float3)(dot(camera.p0, y), dot(camera.p1, y), dot(camera.p2, y));
-  return g;
+// The homography from the reference window onto the plane (c, n) and into
+// `camera`. With d a sample's ray and k = n . (c - C), the plane meets the ray
+// at C + (k / n . d) d, whose projection scaled by n . d / k is
+// (n . d / k) P [C; 1] + M d: linear in d, hence in (r, col). That scale must
+// stay positive over the whole window (it is 1 / depth at the centre), else
+// some ray meets the plane behind the reference: false.
+bool window_projection(const NccCamera camera, const ReferenceWindow win, float3 c, float3 n,
+                       GridProjection* g) {
+  const float k = dot(n, c - win.origin);
+  const float s0 = dot(n, win.ray0) / k;
+  const float sx = dot(n, win.ray_x) / k;
+  const float sy = dot(n, win.ray_y) / k;
+  const float half_size = (float)(PATCH_SIZE / 2);
+  if (!(s0 - half_size * (fabs(sx) + fabs(sy)) > 0.0f)) {
+    return false;
+  }
+  const float4 o = (float4)(win.origin, 1.0f);
+  const float3 q = (float3)(dot(camera.p0, o), dot(camera.p1, o), dot(camera.p2, o));
+  const float3 m0 = camera.p0.xyz;
+  const float3 m1 = camera.p1.xyz;
+  const float3 m2 = camera.p2.xyz;
+  g->h0 = s0 * q + (float3)(dot(m0, win.ray0), dot(m1, win.ray0), dot(m2, win.ray0));
+  g->hx = sx * q + (float3)(dot(m0, win.ray_x), dot(m1, win.ray_x), dot(m2, win.ray_x));
+  g->hy = sy * q + (float3)(dot(m0, win.ray_y), dot(m1, win.ray_y), dot(m2, win.ray_y));
+  return true;
 }
 
 // Image `index` at the projection of the grid sample (r, col), offsets from
@@ -147,36 +196,62 @@ float sample_grid(__global const float* images, __global const int4* table, int 
   return sample_image(images, table, index, h.x / h.z, h.y / h.z);
 }
 
-// The NCC of `a` and `b` (NCC_NUM_SAMPLES values each), each sample k
-// weighted by w[k] (ncc_weights), two-pass so that bright images do not lose
-// the variance to cancellation; NaN when either weighted variance is below
-// NCC_MIN_VARIANCE. With every weight 1 it is the plain NCC.
-float ncc_of(const float* a, const float* b, const float* w) {
-  float sum_w = 0.0f;
-  float mean_a = 0.0f;
+// The reference half of the NCC: subtracts the weighted mean of `a`
+// (NCC_NUM_SAMPLES values, weights w from ncc_weights) from it in place and
+// sets *sum_w and *saa, the weighted sum of its squared deviations; false
+// when its weighted variance is below NCC_MIN_VARIANCE. Split from ncc_of so
+// that a window scored against several views, or many candidate planes,
+// is normalised once.
+bool ncc_centre(float* a, const float* w, float* sum_w, float* saa) {
+  float sw = 0.0f;
+  float mean = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    sw += w[k];
+    mean += w[k] * a[k];
+  }
+  mean /= sw;
+  float ss = 0.0f;
+  for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
+    a[k] -= mean;
+    ss += w[k] * a[k] * a[k];
+  }
+  *sum_w = sw;
+  *saa = ss;
+  return ss >= NCC_MIN_VARIANCE * sw;
+}
+
+// The NCC of a window centred by ncc_centre (`da`, sum_w, saa) and `b`,
+// two-pass so that bright images do not lose the variance to cancellation;
+// NaN when b's weighted variance is below NCC_MIN_VARIANCE.
+float ncc_against(const float* da, float sum_w, float saa, const float* b, const float* w) {
   float mean_b = 0.0f;
   for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-    sum_w += w[k];
-    mean_a += w[k] * a[k];
     mean_b += w[k] * b[k];
   }
-  mean_a /= sum_w;
   mean_b /= sum_w;
-  float saa = 0.0f;
   float sbb = 0.0f;
   float sab = 0.0f;
   for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-    const float da = a[k] - mean_a;
     const float db = b[k] - mean_b;
-    saa += w[k] * da * da;
     sbb += w[k] * db * db;
-    sab += w[k] * da * db;
+    sab += w[k] * da[k] * db;
   }
-  const float min_sum = NCC_MIN_VARIANCE * sum_w;
-  if (!(saa >= min_sum && sbb >= min_sum)) {
+  if (!(sbb >= NCC_MIN_VARIANCE * sum_w)) {
     return NAN;
   }
   return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+}
+
+// The NCC of `a` and `b`, each sample k weighted by w[k]; NaN when either
+// weighted variance is below NCC_MIN_VARIANCE. With every weight 1 it is the
+// plain NCC. `a` is left centred (ncc_centre).
+float ncc_of(float* a, const float* b, const float* w) {
+  float sum_w;
+  float saa;
+  if (!ncc_centre(a, w, &sum_w, &saa)) {
+    return NAN;
+  }
+  return ncc_against(a, sum_w, saa, b, w);
 }
 
 // The weights of the reference samples `a`: 1 each when NCC_SIGMA_COLOR is

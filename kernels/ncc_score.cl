@@ -1,8 +1,10 @@
 // Batched NCC scoring of PMVS patches (method.md 3.1): one work-item per
-// (patch, view) pair. See kernels/README.md for the data layout; the structs
-// and NCC primitives are in ncc.cl, their host mirrors in host/device/ncc_scorer.h
-// (with static_asserts on their layout), and NccScoreReference (host/device/ncc_scorer.cc) is the
-// double-precision twin that must keep exactly the same geometry and NaN rules.
+// patch and its run of (patch, view) pairs. See kernels/README.md for the
+// data layout; the structs and NCC primitives are in ncc.cl, their host
+// mirrors in host/device/ncc_scorer.h (with static_asserts on their layout),
+// and NccScoreReference (host/match/ncc_score_reference.cc) is the
+// double-precision twin that must keep exactly the same geometry and NaN
+// rules.
 //
 // All coordinates are local (relative to the block's origin), in float32.
 //
@@ -21,62 +23,89 @@
 
 // scores[i] = NCC of patch pairs[i].x between its reference image and image
 // pairs[i].y, for i < num_pairs; NaN when any sample is outside either image
-// or not in front of its camera, the grid is undefined, or a sample vector is
-// flat. Out-of-range indices also give NaN (the host rejects them first; the
+// or not in front of its camera, a window ray meets the plane behind the
+// reference, the plane is seen too obliquely, or a sample vector is flat.
+// One work-item per run of pairs [run_offsets[r], run_offsets[r + 1])
+// that share one patch (the host cuts pairs into runs of equal pairs[i].x):
+// the patch's reference window is sampled, weighted and centred once for all
+// of its views, where one work-item per pair sampled it once per view.
+// Out-of-range indices also give NaN (the host rejects them first; the
 // guard only keeps a bad device-side batch from reading out of bounds).
 __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_score(
     __global const float* restrict images, __global const int4* restrict image_table,
     __global const NccCamera* restrict cameras, const int num_images,
     __global const NccPatch* restrict patches, const int num_patches,
-    __global const int2* restrict pairs, const int num_pairs, __global float* restrict scores) {
-  const int i = (int)get_global_id(0);
-  if (i >= num_pairs) {
+    __global const int2* restrict pairs, __global const int* restrict run_offsets,
+    const int num_runs, __global float* restrict scores) {
+  const int run = (int)get_global_id(0);
+  if (run >= num_runs) {
     return;
   }
-  const int2 pair = pairs[i];
-  if (pair.x < 0 || pair.x >= num_patches || pair.y < 0 || pair.y >= num_images) {
+  const int first = run_offsets[run];
+  const int end = run_offsets[run + 1];
+  for (int i = first; i < end; ++i) {
     scores[i] = NAN;
+  }
+  const int patch_index = pairs[first].x;
+  if (patch_index < 0 || patch_index >= num_patches) {
     return;
   }
-  const NccPatch patch = patches[pair.x];
+  const NccPatch patch = patches[patch_index];
   if (patch.reference < 0 || patch.reference >= num_images) {
-    scores[i] = NAN;
     return;
   }
   const NccCamera ref = cameras[patch.reference];
-  const NccCamera view = cameras[pair.y];
   const float3 c = patch.center.xyz;
   const float3 n = patch.normal.xyz;
-
-  float3 dx, dy;
-  if (!patch_axes(ref, c, n, &dx, &dy)) {
-    scores[i] = NAN;
+  ReferenceWindow win;
+  if (!plane_seen(ref, c, n) || !reference_window(ref, c, &win)) {
     return;
   }
-
-  float a[NCC_NUM_SAMPLES];
-  float b[NCC_NUM_SAMPLES];
   const int half_size = PATCH_SIZE / 2;
-  const GridProjection ga = project_grid(ref, c, dx, dy);
-  const GridProjection gb = project_grid(view, c, dx, dy);
+  float a[NCC_NUM_SAMPLES];
   for (int r = 0; r < PATCH_SIZE; ++r) {
-    const float fr = (float)(r - half_size);
     for (int col = 0; col < PATCH_SIZE; ++col) {
-      const float fc = (float)(col - half_size);
-      const float va = sample_grid(images, image_table, patch.reference, ga, fr, fc);
-      const float vb = sample_grid(images, image_table, pair.y, gb, fr, fc);
-      // One NaN sample (outside, behind, or a NaN pixel) voids the pair.
-      if (isnan(va) || isnan(vb)) {
-        scores[i] = NAN;
+      const float va = sample_reference(images, image_table, patch.reference, win,
+                                        (float)(r - half_size), (float)(col - half_size));
+      // One NaN sample (outside or a NaN pixel) voids every pair.
+      if (isnan(va)) {
         return;
       }
       a[r * PATCH_SIZE + col] = va;
-      b[r * PATCH_SIZE + col] = vb;
     }
   }
   float w[NCC_NUM_SAMPLES];
   ncc_weights(a, w);
-  scores[i] = ncc_of(a, b, w);
+  float sum_w;
+  float saa;
+  if (!ncc_centre(a, w, &sum_w, &saa)) {
+    return;
+  }
+  float b[NCC_NUM_SAMPLES];
+  for (int i = first; i < end; ++i) {
+    const int2 pair = pairs[i];
+    GridProjection gb;
+    if (pair.x != patch_index || pair.y < 0 || pair.y >= num_images ||
+        !window_projection(cameras[pair.y], win, c, n, &gb)) {
+      continue;
+    }
+    bool valid = true;
+    for (int r = 0; r < PATCH_SIZE && valid; ++r) {
+      for (int col = 0; col < PATCH_SIZE; ++col) {
+        const float vb = sample_grid(images, image_table, pair.y, gb, (float)(r - half_size),
+                                     (float)(col - half_size));
+        // One NaN sample (outside, behind, or a NaN pixel) voids the pair.
+        if (isnan(vb)) {
+          valid = false;
+          break;
+        }
+        b[r * PATCH_SIZE + col] = vb;
+      }
+    }
+    if (valid) {
+      scores[i] = ncc_against(a, sum_w, saa, b, w);
+    }
+  }
 }
 
 // values[k] = image `image_index` of the packed buffer at points[k]; exposes

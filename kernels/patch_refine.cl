@@ -45,42 +45,29 @@ float3 normal_of(float3 e_x, float3 e_y, float3 e_z, float yaw, float pitch) {
   return (cp * sin(yaw)) * e_x + sin(pitch) * e_y + (cp * cos(yaw)) * e_z;
 }
 
-// Mean NCC of the patch (c, n) in `ref` against each of its `num_views` views
-// (NCCs into `nccs`); NaN when any view's NCC is NaN (ncc_score's rules).
+// Mean NCC of the plane (c, n) seen through the reference window `win`, whose
+// samples `da` are centred by ncc_centre (sum_w, saa) and weighted by w,
+// against each of its `num_views` views (NCCs into `nccs`); NaN when any
+// view's NCC is NaN (ncc_score's rules). With `all` false it stops at the
+// first NaN view, leaving the later ones NaN: a search candidate that is
+// invalid is discarded whatever its other views score.
 float patch_views_ncc(__global const float* images, __global const int4* table,
                       __global const NccCamera* cameras, int reference, const int* views,
-                      int num_views, float3 c, float3 n, float* nccs) {
+                      int num_views, const ReferenceWindow win, const float* da, const float* w,
+                      float sum_w, float saa, float3 c, float3 n, bool all, float* nccs) {
   for (int v = 0; v < num_views; ++v) {
     nccs[v] = NAN;
   }
-  const NccCamera ref = cameras[reference];
-  float3 dx, dy;
-  if (!patch_axes(ref, c, n, &dx, &dy)) {
+  if (!plane_seen(cameras[reference], c, n)) {
     return NAN;
   }
   const int half_size = PATCH_SIZE / 2;
-
-  // The reference samples once, shared by every view.
-  float a[NCC_NUM_SAMPLES];
-  const GridProjection ga = project_grid(ref, c, dx, dy);
-  for (int r = 0; r < PATCH_SIZE; ++r) {
-    for (int col = 0; col < PATCH_SIZE; ++col) {
-      const float va =
-          sample_grid(images, table, reference, ga, (float)(r - half_size), (float)(col - half_size));
-      if (isnan(va)) {
-        return NAN;
-      }
-      a[r * PATCH_SIZE + col] = va;
-    }
-  }
-  float w[NCC_NUM_SAMPLES];
-  ncc_weights(a, w);
   float sum = 0.0f;
   bool all_valid = true;
   float b[NCC_NUM_SAMPLES];
-  for (int v = 0; v < num_views; ++v) {
-    const GridProjection gb = project_grid(cameras[views[v]], c, dx, dy);
-    bool valid = true;
+  for (int v = 0; v < num_views && (all || all_valid); ++v) {
+    GridProjection gb;
+    bool valid = window_projection(cameras[views[v]], win, c, n, &gb);
     for (int r = 0; r < PATCH_SIZE && valid; ++r) {
       for (int col = 0; col < PATCH_SIZE; ++col) {
         const float vb = sample_grid(images, table, views[v], gb, (float)(r - half_size),
@@ -92,7 +79,7 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
         b[r * PATCH_SIZE + col] = vb;
       }
     }
-    nccs[v] = valid ? ncc_of(a, b, w) : NAN;
+    nccs[v] = valid ? ncc_against(da, sum_w, saa, b, w) : NAN;
     if (isnan(nccs[v])) {
       all_valid = false;
     } else {
@@ -126,8 +113,9 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
     __global const NccCamera* restrict cameras, const int num_images,
     __global const NccPatch* restrict patches, const int num_patches,
     __global const int* restrict view_offsets, __global const int* restrict view_indices,
-    const int iterations, const int max_halvings, const float depth_step, const float angle_step, const float max_angle,
-    __global RefinedPatchOut* restrict results, __global float* restrict view_scores) {
+    const int iterations, const int max_halvings, const float depth_step, const float angle_step,
+    const float max_angle, __global RefinedPatchOut* restrict results,
+    __global float* restrict view_scores) {
   const int i = (int)get_global_id(0);
   if (i >= num_patches) {
     return;
@@ -169,14 +157,40 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   float step[3] = {depth_step * footprint, angle_step, angle_step};
   float nccs[MAX_VIEWS];
   float trial[MAX_VIEWS];
-  float score = NAN;
-  if (fabs(p[1]) <= max_angle && fabs(p[2]) <= max_angle) {
-    score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
-                            origin + p[0] * ray, normal_of(e_x, e_y, e_z, p[1], p[2]), nccs);
-  } else {
-    for (int v = 0; v < num_views; ++v) {
-      nccs[v] = NAN;
+  for (int v = 0; v < num_views; ++v) {
+    nccs[v] = NAN;
+  }
+  // Every candidate's centre lies on the ray through c0, so all share c0's
+  // reference window: sampled, weighted and centred here, once.
+  ReferenceWindow win;
+  float da[NCC_NUM_SAMPLES];
+  float w[NCC_NUM_SAMPLES];
+  float sum_w = 0.0f;
+  float saa = 0.0f;
+  bool window_valid = reference_window(ref, c0, &win);
+  const int half_size = PATCH_SIZE / 2;
+  for (int r = 0; r < PATCH_SIZE && window_valid; ++r) {
+    for (int col = 0; col < PATCH_SIZE; ++col) {
+      const float va = sample_reference(images, image_table, patch.reference, win,
+                                        (float)(r - half_size), (float)(col - half_size));
+      if (isnan(va)) {
+        window_valid = false;
+        break;
+      }
+      da[r * PATCH_SIZE + col] = va;
     }
+  }
+  if (window_valid) {
+    ncc_weights(da, w);
+    window_valid = ncc_centre(da, w, &sum_w, &saa);
+  }
+  // Without a valid window every candidate is NaN, and the search below
+  // halves its steps to the end as the reference's does.
+  float score = NAN;
+  if (window_valid && fabs(p[1]) <= max_angle && fabs(p[2]) <= max_angle) {
+    score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views, win,
+                            da, w, sum_w, saa, origin + p[0] * ray,
+                            normal_of(e_x, e_y, e_z, p[1], p[2]), true, nccs);
   }
   int moves = 0;
   int halvings = 0;
@@ -191,9 +205,11 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
       if (!(fabs(q[1]) <= max_angle && fabs(q[2]) <= max_angle)) {
         continue;
       }
-      const float s =
-          patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
-                          origin + q[0] * ray, normal_of(e_x, e_y, e_z, q[1], q[2]), trial);
+      const float s = !window_valid
+                          ? NAN
+                          : patch_views_ncc(images, image_table, cameras, patch.reference, views,
+                                            num_views, win, da, w, sum_w, saa, origin + q[0] * ray,
+                                            normal_of(e_x, e_y, e_z, q[1], q[2]), false, trial);
       ++evaluations;
       if (improves(s, score)) {
         moved = k;

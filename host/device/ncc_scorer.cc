@@ -100,13 +100,24 @@ std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
   patch_buffer.WriteVector(patches);
   ClBuffer pair_buffer(context_, pairs.size() * sizeof(NccPair), CL_MEM_READ_ONLY);
   pair_buffer.WriteVector(pairs);
+  // Runs of consecutive pairs of one patch, one work-item each, which samples
+  // the patch's reference window once for the run: callers list a patch's
+  // views together.
+  std::vector<cl_int> run_offsets = {0};
+  for (size_t i = 1; i < pairs.size(); ++i) {
+    if (pairs[i].patch != pairs[i - 1].patch) run_offsets.push_back(static_cast<cl_int>(i));
+  }
+  run_offsets.push_back(static_cast<cl_int>(pairs.size()));
+  const size_t num_runs = run_offsets.size() - 1;
+  ClBuffer run_buffer(context_, run_offsets.size() * sizeof(cl_int), CL_MEM_READ_ONLY);
+  run_buffer.WriteVector(run_offsets);
   ClBuffer score_buffer(context_, pairs.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
-  const cl_int num_pairs = static_cast<cl_int>(pairs.size());
   score_kernel_.SetArgs(group_->images, group_->image_table, group_->cameras,
                         cl_int{group_->num_images}, patch_buffer,
-                        static_cast<cl_int>(patches.size()), pair_buffer, num_pairs, score_buffer);
-  ClEvent launched = context_.Enqueue(score_kernel_, NDRange(pairs.size()),
+                        static_cast<cl_int>(patches.size()), pair_buffer, run_buffer,
+                        static_cast<cl_int>(num_runs), score_buffer);
+  ClEvent launched = context_.Enqueue(score_kernel_, NDRange(num_runs),
                                       NDRange(static_cast<size_t>(options_.work_group_size)));
   // The blocking read on the in-order queue waits for the kernel.
   std::vector<float> scores(pairs.size());

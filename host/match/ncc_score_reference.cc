@@ -53,12 +53,11 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
   const Eigen::Vector3d n = Xyz(patch.normal);
   const double depth = Xyzw(ref.p[2]).dot(c.homogeneous());
   if (!(depth > 0.0)) return nan;
-  // Same grid axes as the kernel (see patch_axes in ncc.cl).
+  // The same plane test as the kernel (plane_seen in ncc.cl).
   const Eigen::Vector3d x_proj = Xyz(ref.x_axis) - Xyz(ref.x_axis).dot(n) * n;
   if (!(x_proj.norm() >= kNccMinAxisLength)) return nan;
   const Eigen::Vector3d x_dir = x_proj.normalized();
-  Eigen::Vector3d y_dir = n.cross(x_dir);
-  if (y_dir.dot(Xyz(ref.y_axis)) < 0.0) y_dir = -y_dir;
+  const Eigen::Vector3d y_dir = n.cross(x_dir);
   const double u0 = Xyzw(ref.p[0]).dot(c.homogeneous()) / depth;
   const double v0 = Xyzw(ref.p[1]).dot(c.homogeneous()) / depth;
   const Eigen::Vector3d ju = Xyz(ref.p[0]) - u0 * Xyz(ref.p[2]);
@@ -67,16 +66,32 @@ double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, 
   const double y_pixels = std::hypot(ju.dot(y_dir), jv.dot(y_dir)) / depth;
   const double min_pixels = kMinForeshortening * (ref.center.s[3] / depth);
   if (!(x_pixels >= min_pixels && y_pixels >= min_pixels)) return nan;
-  // The kernel's SAMPLE_STEP is a float literal.
+  // The window: reference pixels `step` apart around c's projection, each
+  // sample where that pixel's ray meets the plane. The kernel's SAMPLE_STEP
+  // is a float literal.
   const double step = static_cast<float>(sample_step);
-  const Eigen::Vector3d step_x = (step / x_pixels) * x_dir;
-  const Eigen::Vector3d step_y = (step / y_pixels) * y_dir;
+  Eigen::Matrix3d m;
+  for (int row = 0; row < 3; ++row) m.row(row) = Xyz(ref.p[row]).transpose();
+  const Eigen::Matrix3d m_inv = m.inverse();
+  const Eigen::Vector3d origin = Xyz(ref.center);
+  const double plane = n.dot(c - origin);
+  auto sample_point = [&](int r, int col, Eigen::Vector3d* x) {
+    const Eigen::Vector3d ray =
+        m_inv * Eigen::Vector3d(u0 + step * (col - half), v0 + step * (r - half), 1.0);
+    const double lambda = plane / n.dot(ray);
+    *x = origin + lambda * ray;
+    return lambda > 0.0;  // the plane ahead of the reference along the ray
+  };
 
   bool valid = true;
   double margin = std::numeric_limits<double>::infinity();
   for (int r = 0; r < patch_size && valid; ++r) {
     for (int col = 0; col < patch_size && valid; ++col) {
-      const Eigen::Vector3d x = c + (col - half) * step_x + (r - half) * step_y;
+      Eigen::Vector3d x;
+      if (!sample_point(r, col, &x)) {
+        valid = false;
+        break;
+      }
       for (int v = 0; v < 2 && valid; ++v) {
         const NccCamera& camera = group.cameras[views[v]];
         const FloatImageView& image = group.images[views[v]];
