@@ -79,24 +79,36 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     visit(patch.ref);
     for (const int v : patch.views) visit(v);
   };
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!in(i)) continue;
-    for_each_view(i, [&](int v, size_t cell, double d, double) {
-      float& m = buffers[v].min_depth[cell];
-      m = std::min(m, static_cast<float>(d));
-    });
-  }
   auto weight = [&](size_t i) {
     const AcceptedPatch& p = patches[points[i].patch];
     return static_cast<float>((1 + p.views.size()) * std::max(0.0f, p.score));
   };
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!in(i)) continue;
-    const float w = weight(i);
-    for_each_view(i, [&](int v, size_t cell, double d, double tol) {
-      Buffer& b = buffers[v];
-      (d <= b.min_depth[cell] + tol ? b.front[cell] : b.back[cell]) += w;
-    });
+  // One thread per image fills its buffers, in point order as one thread
+  // would, so the sums do not depend on the thread count (these projections
+  // ran on one core while the other waited).
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int v = 0; v < n; ++v) {
+    Buffer& b = buffers[v];
+    auto seen = [&](size_t i) {
+      if (!in(i)) return false;
+      const AcceptedPatch& patch = patches[points[i].patch];
+      return patch.ref == v ||
+             std::find(patch.views.begin(), patch.views.end(), v) != patch.views.end();
+    };
+    for (size_t i = 0; i < points.size(); ++i) {
+      size_t cell = 0;
+      double d = 0, tol = 0;
+      if (!seen(i) || !locate(v, points[i].x, patches[points[i].patch].normal, &cell, &d, &tol))
+        continue;
+      b.min_depth[cell] = std::min(b.min_depth[cell], static_cast<float>(d));
+    }
+    for (size_t i = 0; i < points.size(); ++i) {
+      size_t cell = 0;
+      double d = 0, tol = 0;
+      if (!seen(i) || !locate(v, points[i].x, patches[points[i].patch].normal, &cell, &d, &tol))
+        continue;
+      (d <= b.min_depth[cell] + tol ? b.front[cell] : b.back[cell]) += weight(i);
+    }
   }
   std::vector<bool> keep(points.size(), false);
 #pragma omp parallel for schedule(static)
