@@ -6,7 +6,7 @@
 // PNG chart (time and points per preset, both modes). Each run's profile
 // (sapmvs run --profile) lands in WORK/run_PRESET_MODE/profile.{csv,json,txt}.
 //
-//   end_to_end [--presets small,campus,city] [--work /tmp/sapmvs_e2e]
+//   end_to_end [--presets small,campus,city] [--modes sapmvs,pmvs] [--work /tmp/sapmvs_e2e]
 //              [--csv profiling/results/end_to_end.csv]
 //              [--chart profiling/results/end_to_end.png] [matcher flags of `sapmvs run`]
 #include <CLI/CLI.hpp>
@@ -93,10 +93,16 @@ void DrawChart(const std::vector<Row>& rows, const std::vector<std::string>& pre
 int main(int argc, char** argv) {
   CLI::App app("End-to-end benchmark: whole runs of presets in both modes");
   std::vector<std::string> presets = {"small", "campus", "city"};
+  std::vector<std::string> modes = {"sapmvs", "pmvs"};
   std::string work = "/tmp/sapmvs_e2e", csv_path = "profiling/results/end_to_end.csv";
   std::string chart_path = "profiling/results/end_to_end.png", device;
   MatcherOptions base;
   app.add_option("--presets", presets, "Simulator presets")->delimiter(',')->capture_default_str();
+  app.add_option("--modes", modes,
+                 "Modes to run (one alone for an ablation: its ratios then print nothing)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"sapmvs", "pmvs"}))
+      ->capture_default_str();
   app.add_option("--work", work, "Folder for the simulated blocks and runs")->capture_default_str();
   app.add_option("--csv", csv_path, "CSV to write")->capture_default_str();
   app.add_option("--chart", chart_path, "PNG chart to write")->capture_default_str();
@@ -122,7 +128,7 @@ int main(int argc, char** argv) {
       const Block block = ReadBlock(sim / "block.yaml");
       const Truth truth = ReadTruth(sim / "truth" / "dsm.tif");
       const double gsd = EstimateBlockGeometry(block).gsd_median;
-      for (const char* mode : {"sapmvs", "pmvs"}) {
+      for (const std::string& mode : modes) {
         std::cerr << preset << " " << mode << "...\n";
         RunOptions o;
         o.block = sim / "block.yaml";
