@@ -34,6 +34,7 @@
 // numbers are compare_modes' and end_to_end's (truth_check.h).
 #include <unistd.h>
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <fstream>
@@ -68,7 +69,27 @@ struct Row {
   // its wrong ones; this says how many of its right ones ours miss.
   std::optional<double> right_from_pmvs2;
   std::optional<SurfaceCheck> truth;
+  // sapmvs: CPU / wall over its matching stages (report.json), without the
+  // reading, planning, merging and writing around them.
+  std::optional<double> matching_busy;
 };
+
+// CPU / wall over the matching stages of a sapmvs run's report.json (those
+// with cpu_seconds, not the run's own "run ..." stages); none when the
+// binary does not record CPU time.
+std::optional<double> MatchingBusy(const fs::path& report) {
+  std::ifstream f(report);
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  if (j.is_discarded() || !j.contains("stages")) return std::nullopt;
+  double wall = 0, cpu = 0;
+  for (const nlohmann::json& s : j["stages"]) {
+    if (!s.contains("cpu_seconds") || s["stage"].get<std::string>().rfind("run ", 0) == 0) continue;
+    wall += s["wall_seconds"].get<double>();
+    cpu += s["cpu_seconds"].get<double>();
+  }
+  if (!(wall > 0 && cpu > 0)) return std::nullopt;
+  return cpu / wall;
+}
 
 // The folder of the build that holds this binary (build/profiling/x -> build).
 fs::path BuildDir() {
@@ -197,21 +218,22 @@ std::string Share(const std::optional<double>& v) { return v ? Fixed(100 * *v, 1
 
 std::string Table(const std::vector<Row>& rows, bool with_truth) {
   std::ostringstream t;
-  t << "| tool / mode | wall s | CPU s | CPU/wall | peak RSS MiB | points "
+  t << "| tool / mode | wall s | CPU s | CPU/wall | matching CPU/wall | peak RSS MiB | points "
        "| PMVS2→ours 1 GSD | PMVS2→ours 2 GSD | ours→PMVS2 1 GSD | ours→PMVS2 2 GSD |";
   if (with_truth) {
     t << " PMVS2's right points→ours 2 GSD | within 1 GSD | median \\|dz\\| | coverage |";
   }
-  t << "\n|---|---|---|---|---|---|---|---|---|---|" << (with_truth ? "---|---|---|---|" : "")
+  t << "\n|---|---|---|---|---|---|---|---|---|---|---|" << (with_truth ? "---|---|---|---|" : "")
     << "\n";
   for (const Row& r : rows) {
     const ChildUsage& u = r.usage;
     if (r.timed) {
       t << "| " << r.name << " | " << Fixed(u.wall_seconds, 1) << " | " << Fixed(u.cpu_seconds, 1)
         << " | " << Fixed(u.cpu_seconds / std::max(u.wall_seconds, 1e-9), 2) << " | "
-        << Fixed(u.peak_rss_mib, 0) << " | ";
+        << (r.matching_busy ? Fixed(*r.matching_busy, 2) : "–") << " | " << Fixed(u.peak_rss_mib, 0)
+        << " | ";
     } else {
-      t << "| " << r.name << " | – | – | – | – | ";
+      t << "| " << r.name << " | – | – | – | – | – | ";
     }
     t << r.cloud.points.size() << " | " << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1])
       << " | " << Share(r.to_pmvs2[0]) << " | " << Share(r.to_pmvs2[1]) << " |";
@@ -345,6 +367,7 @@ int main(int argc, char** argv) {
       if (!run_flags.empty()) r.name += " " + run_flags;
       r.usage = Step(c, &commands);
       r.cloud = ReadPly(run / "cloud.ply");
+      r.matching_busy = MatchingBusy(run / "report.json");
       rows.push_back(std::move(r));
     }
 

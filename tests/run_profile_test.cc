@@ -31,7 +31,7 @@ RunReport MadeUpReport() {
   refine.max_seconds = 1.5;
   r.stats.kernels["ncc_score 7x7"] = score;
   r.stats.kernels["patch_refine 21x21"] = refine;
-  r.stats.stages = {{"load", {1.0, 0.0}}, {"propagation", {3.0, 2.5}}};
+  r.stats.stages = {{"load", {1.0, 0.0, 1.0}}, {"propagation", {3.0, 2.5, 5.4}}};
   r.stages = {{"plan", 0.5}, {"match", 4.0}, {"merge", 2.0}};
   return r;
 }
@@ -71,6 +71,15 @@ TEST(RunProfile, PhasesSortedByWallWithHostTime) {
   EXPECT_DOUBLE_EQ(p[0].host(), 0.5);
   EXPECT_EQ(p[1].phase, "run merge");
   for (size_t i = 1; i < p.size(); ++i) EXPECT_GE(p[i - 1].wall, p[i].wall);
+}
+
+TEST(RunProfile, MatchingPhasesSayHowBusyTheyKeptTheCores) {
+  std::ostringstream out;
+  PrintProfile(MadeUpReport(), out);
+  const std::string text = out.str();
+  // propagation 5.4 / 3.0 s; the matching, (1.0 + 5.4) / (1.0 + 3.0) s.
+  EXPECT_NE(text.find("1.80"), std::string::npos) << text;
+  EXPECT_NE(text.find("matching 4.000 s wall, CPU/wall 1.60"), std::string::npos) << text;
 }
 
 class RunProfileFiles : public test::ScratchTest {};

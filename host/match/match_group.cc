@@ -15,6 +15,7 @@
 #include "match/patch_filter.h"
 #include "match/propagation.h"
 #include "match/seed_matcher.h"
+#include "sapmvs/util/cpu_time.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
 #include "sapmvs/util/memory_use.h"
@@ -78,12 +79,16 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   report("load");
   auto stage_start = std::chrono::steady_clock::now();
   double device_before = 0;
+  double cpu_before = ProcessCpuSeconds();
   const PatchEngine* engine_ptr = nullptr;
   auto end_stage = [&](const std::string& name) {
     StageTime t;
     t.wall = Seconds(stage_start);
     const double device_now = engine_ptr ? DeviceSeconds(*engine_ptr) : 0;
     t.device = device_now - device_before;
+    const double cpu_now = ProcessCpuSeconds();
+    t.cpu = cpu_now - cpu_before;
+    cpu_before = cpu_now;
     t.peak_rss_bytes = PeakRssBytes();
     device_before = device_now;
     // Stages repeated by the expand-filter passes add up under one name.
@@ -94,6 +99,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     } else {
       same->second.wall += t.wall;
       same->second.device += t.device;
+      same->second.cpu += t.cpu;
       same->second.peak_rss_bytes = t.peak_rss_bytes;
     }
     stage_start = std::chrono::steady_clock::now();

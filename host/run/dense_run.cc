@@ -85,6 +85,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
     } else {
       it->second.wall += t.wall;
       it->second.device += t.device;
+      it->second.cpu += t.cpu;
       it->second.peak_rss_bytes = std::max(it->second.peak_rss_bytes, t.peak_rss_bytes);
     }
   }
@@ -339,6 +340,7 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
     out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t.wall
         << " s wall";
     if (t.device > 0) out << ", " << t.device << " s in kernels";
+    if (t.wall > 0 && t.cpu > 0) out << ", CPU/wall " << t.cpu / t.wall;
     if (t.peak_rss_bytes > 0)
       out << ", peak " << std::lround(t.peak_rss_bytes / (1 << 20)) << " MiB";
     out << "\n";

@@ -43,7 +43,9 @@ std::vector<KernelProfile> ProfileKernels(const MatchStats& stats) {
 
 std::vector<PhaseProfile> ProfilePhases(const RunReport& report) {
   std::vector<PhaseProfile> out;
-  for (const auto& [name, t] : report.stats.stages) out.push_back({name, t.wall, t.device});
+  for (const auto& [name, t] : report.stats.stages) {
+    out.push_back({name, t.wall, t.device, t.cpu});
+  }
   for (const auto& [name, wall] : report.stages) {
     if (name == "match") continue;  // the stages above, summed
     out.push_back({"run " + name, wall, 0});
@@ -82,15 +84,27 @@ void PrintProfile(const RunReport& report, std::ostream& out) {
     out << line;
   }
   if (device == 0) out << "(no device times: the queue did not profile)\n";
-  out << "\nprofile: phases, by wall time (host = wall - device)\n";
-  std::snprintf(line, sizeof line, "%-18s %10s %10s %10s %7s\n", "phase", "wall s", "device s",
-                "host s", "share");
+  out << "\nprofile: phases, by wall time (host = wall - device; CPU/wall of the matching"
+         " phases)\n";
+  std::snprintf(line, sizeof line, "%-18s %10s %10s %10s %7s %9s\n", "phase", "wall s", "device s",
+                "host s", "share", "CPU/wall");
   out << line;
+  double match_wall = 0, match_cpu = 0;
   for (const PhaseProfile& p : ProfilePhases(report)) {
-    std::snprintf(line, sizeof line, "%-18s %10.3f %10.3f %10.3f %6.1f%%\n", p.phase.c_str(),
+    const std::string busy = p.cpu > 0 && p.wall > 0 ? F("%.2f", p.cpu / p.wall) : "-";
+    std::snprintf(line, sizeof line, "%-18s %10.3f %10.3f %10.3f %6.1f%% %9s\n", p.phase.c_str(),
                   p.wall, p.device, p.host(),
-                  report.total_seconds > 0 ? 100 * p.wall / report.total_seconds : 0.0);
+                  report.total_seconds > 0 ? 100 * p.wall / report.total_seconds : 0.0,
+                  busy.c_str());
     out << line;
+    if (p.cpu > 0) {
+      match_wall += p.wall;
+      match_cpu += p.cpu;
+    }
+  }
+  if (match_wall > 0) {
+    out << "matching " << F("%.3f", match_wall) << " s wall, CPU/wall "
+        << F("%.2f", match_cpu / match_wall) << "\n";
   }
   out << "total " << F("%.3f", report.total_seconds) << " s wall, " << F("%.3f", device)
       << " s in kernels ("
@@ -102,17 +116,18 @@ void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
   const std::vector<PhaseProfile> phases = ProfilePhases(report);
   WriteStreamAtomically(csv, [&](std::ostream& f) {
     f << "kind,name,launches,items,ncc_evaluations,seconds,mean_ms,max_ms,items_per_s,"
-         "ncc_evaluations_per_s,est_bytes,est_flops,gb_per_s,gflop_per_s,wall_s,device_s,host_s\n";
+         "ncc_evaluations_per_s,est_bytes,est_flops,gb_per_s,gflop_per_s,wall_s,device_s,host_s,"
+         "cpu_s\n";
     f << std::setprecision(9);
     for (const KernelProfile& k : kernels) {
       f << "kernel," << k.kernel << "," << k.launches << "," << k.items << "," << k.ncc_evaluations
         << "," << k.seconds << "," << k.mean_ms << "," << k.max_ms << "," << k.items_per_second
         << "," << k.evaluations_per_second << "," << k.bytes << "," << k.flops << ","
-        << k.gb_per_second << "," << k.gflop_per_second << ",,,\n";
+        << k.gb_per_second << "," << k.gflop_per_second << ",,,,\n";
     }
     for (const PhaseProfile& p : phases) {
       f << "phase," << p.phase << ",,,,,,,,,,,,," << p.wall << "," << p.device << "," << p.host()
-        << "\n";
+        << "," << p.cpu << "\n";
     }
   });
   nlohmann::json j;
@@ -136,8 +151,11 @@ void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
   }
   j["phases"] = nlohmann::json::array();
   for (const PhaseProfile& p : phases) {
-    j["phases"].push_back(
-        {{"phase", p.phase}, {"wall_s", p.wall}, {"device_s", p.device}, {"host_s", p.host()}});
+    j["phases"].push_back({{"phase", p.phase},
+                           {"wall_s", p.wall},
+                           {"device_s", p.device},
+                           {"host_s", p.host()},
+                           {"cpu_s", p.cpu}});
   }
   std::filesystem::path json_path = csv;
   json_path.replace_extension(".json");

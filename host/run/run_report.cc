@@ -54,6 +54,7 @@ nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   for (const auto& [name, t] : s.stages) {
     nlohmann::json stage = {{"stage", name}, {"wall_seconds", t.wall}};
     if (device_times) stage["device_seconds"] = t.device;
+    stage["cpu_seconds"] = t.cpu;
     stages.push_back(stage);
   }
   j["stages"] = stages;

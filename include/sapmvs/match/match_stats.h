@@ -13,6 +13,9 @@ namespace sapmvs {
 struct StageTime {
   double wall = 0;
   double device = 0;
+  // Process CPU seconds (every thread's) during the stage: cpu / wall is how
+  // busy it kept the cores.
+  double cpu = 0;
   // Peak RSS at the stage's end: the group's so far where the run reset the
   // peak at its start (ResetPeakRss), else the process's; over a run's
   // groups, the highest.
