@@ -89,26 +89,25 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
 #pragma omp parallel for schedule(dynamic, 1)
   for (int v = 0; v < n; ++v) {
     Buffer& b = buffers[v];
-    auto seen = [&](size_t i) {
-      if (!in(i)) return false;
-      const AcceptedPatch& patch = patches[points[i].patch];
-      return patch.ref == v ||
-             std::find(patch.views.begin(), patch.views.end(), v) != patch.views.end();
+    // f(i, cell, depth, tolerance) for each point matched in image v.
+    auto for_each_point = [&](auto&& f) {
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (!in(i)) continue;
+        const AcceptedPatch& patch = patches[points[i].patch];
+        if (patch.ref != v &&
+            std::find(patch.views.begin(), patch.views.end(), v) == patch.views.end())
+          continue;
+        size_t cell = 0;
+        double d = 0, tol = 0;
+        if (locate(v, points[i].x, patch.normal, &cell, &d, &tol)) f(i, cell, d, tol);
+      }
     };
-    for (size_t i = 0; i < points.size(); ++i) {
-      size_t cell = 0;
-      double d = 0, tol = 0;
-      if (!seen(i) || !locate(v, points[i].x, patches[points[i].patch].normal, &cell, &d, &tol))
-        continue;
+    for_each_point([&](size_t, size_t cell, double d, double) {
       b.min_depth[cell] = std::min(b.min_depth[cell], static_cast<float>(d));
-    }
-    for (size_t i = 0; i < points.size(); ++i) {
-      size_t cell = 0;
-      double d = 0, tol = 0;
-      if (!seen(i) || !locate(v, points[i].x, patches[points[i].patch].normal, &cell, &d, &tol))
-        continue;
+    });
+    for_each_point([&](size_t i, size_t cell, double d, double tol) {
       (d <= b.min_depth[cell] + tol ? b.front[cell] : b.back[cell]) += weight(i);
-    }
+    });
   }
   std::vector<bool> keep(points.size(), false);
 #pragma omp parallel for schedule(static)
