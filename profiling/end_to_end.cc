@@ -8,7 +8,8 @@
 //
 //   end_to_end [--presets small,campus,city] [--modes sapmvs,pmvs] [--work /tmp/sapmvs_e2e]
 //              [--csv profiling/results/end_to_end.csv]
-//              [--chart profiling/results/end_to_end.png] [matcher flags of `sapmvs run`]
+//              [--chart profiling/results/end_to_end.png]
+//              [matcher and grouping flags of `sapmvs run`]
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -25,6 +26,7 @@
 #include "sapmvs/evaluate/surface_check.h"
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/io/raster_io.h"
+#include "sapmvs/plan/grouping_options.h"
 #include "sapmvs/run/dense_run.h"
 #include "sapmvs/simulate/simulate.h"
 #include "sapmvs/util/error.h"
@@ -109,9 +111,13 @@ int main(int argc, char** argv) {
   app.add_option("--device", device, "OpenCL device");
   // Every matcher flag of `sapmvs run` but --mode (both modes run here).
   cli::AddOptionFlags(&app, &base, cli::CompareModesMatcherFields());
+  GroupingOptions grouping;
+  cli::AddOptionFlags(&app, &grouping);
   CLI11_PARSE(app, argc, argv);
   try {
     if (const std::string problem = base.Problem(); !problem.empty())
+      throw Error("expected " + problem);
+    if (const std::string problem = grouping.Problem(); !problem.empty())
       throw Error("expected " + problem);
     const int level = base.level;
     std::vector<Row> rows;
@@ -137,6 +143,7 @@ int main(int argc, char** argv) {
         o.restart = true;
         o.profile = true;
         o.matcher = base;
+        o.grouping = grouping;
         o.matcher.mode = ParseMatchMode(mode);
         o.matcher.progress = false;
         const RunReport report = RunDense(o);

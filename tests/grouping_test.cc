@@ -106,6 +106,66 @@ TEST(GroupingTable3, CampusStripStrategyMatchesThePaper) {
   EXPECT_TRUE(plan.ungrouped.empty());
 }
 
+// Each strip run also takes the images of other strips that see most of its
+// ground, as views only: never one of its own strip or group, at most
+// strip_views, from the neighbouring strips (campus's side overlap reaches no
+// further), best first; 0 gives the paper's runs alone. The runs themselves
+// stay Table 3's.
+TEST(GroupingStrips, StripViewsComeFromTheNeighbouringStrips) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  ASSERT_EQ(o.strip_views, 2);
+  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
+  EXPECT_EQ(Sizes(plan), (std::vector<size_t>{6, 6, 4, 6, 6, 5, 6, 6, 6, 6, 6, 4}));
+  for (const ImageGroup& g : plan.groups) {
+    EXPECT_EQ(g.views.size(), 2u) << "group of strip " << g.strip;
+    for (const int v : g.views) {
+      EXPECT_NE(s.strip_of[v], g.strip);
+      EXPECT_EQ(std::abs(s.strip_of[v] - g.strip), 1) << s.block.images[v].name;
+      EXPECT_EQ(std::count(g.images.begin(), g.images.end(), v), 0);
+    }
+    EXPECT_EQ(std::set<int>(g.views.begin(), g.views.end()).size(), g.views.size());
+  }
+  GroupingOptions more = o;
+  more.strip_views = 5;
+  const GroupingPlan wide = PlanGroups(s.block, more, MatcherOptions{});
+  for (size_t g = 0; g < wide.groups.size(); ++g) {
+    // The same ranking: the first two of five are the two.
+    ASSERT_GE(wide.groups[g].views.size(), 2u);
+    EXPECT_EQ(std::vector<int>(wide.groups[g].views.begin(), wide.groups[g].views.begin() + 2),
+              plan.groups[g].views);
+    EXPECT_LE(wide.groups[g].views.size(), 5u);
+  }
+  GroupingOptions none = o;
+  none.strip_views = 0;
+  for (const ImageGroup& g : PlanGroups(s.block, none, MatcherOptions{}).groups)
+    EXPECT_TRUE(g.views.empty());
+  // The footprint strategy chooses its images per tile and takes none.
+  GroupingOptions tiles = o;
+  tiles.strategy = GroupingStrategy::kFootprint;
+  for (const ImageGroup& g : PlanGroups(s.block, tiles, MatcherOptions{}).groups)
+    EXPECT_TRUE(g.views.empty());
+}
+
+// A view-only image counts in the memory budget: under a budget that holds 6
+// of campus's (equal) images, a run of 6 takes no views and a shorter one
+// fills up to 6.
+TEST(GroupingStrips, StripViewsStayWithinTheBudget) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o;
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3, 4, 5}, 1).Total() + 1;
+  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
+  for (const ImageGroup& g : plan.groups) {
+    EXPECT_EQ(g.views.size(), std::min<size_t>(2, 6 - g.images.size()));
+    EXPECT_LE(g.memory.Total(), o.memory_budget);
+  }
+  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3, 4, 5, 6}, 1).Total() + 1;
+  for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups) {
+    EXPECT_EQ(g.views.size(), std::min<size_t>(2, 7 - g.images.size()));
+    EXPECT_LE(g.memory.Total(), o.memory_budget);
+  }
+}
+
 // `run` matches what PlanGroups returns; a block that fits one group is not
 // split, whatever the strategy, since splitting it would only lose views.
 TEST(GroupingSingle, ABlockThatFitsIsOneGroupAndALargerOneIsSplit) {
@@ -461,7 +521,9 @@ TEST(GroupingMemory, TheProcessCountsInEveryGroupAndInTheBudget) {
             (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
   for (const ImageGroup& g : with.groups) {
     EXPECT_EQ(g.memory.process_bytes, counted);
-    EXPECT_DOUBLE_EQ(g.memory.Total(), EstimateGroupMemory(s.block, g.images, 1).Total() + counted);
+    std::vector<int> loaded = g.images;  // view-only images are loaded too
+    loaded.insert(loaded.end(), g.views.begin(), g.views.end());
+    EXPECT_DOUBLE_EQ(g.memory.Total(), EstimateGroupMemory(s.block, loaded, 1).Total() + counted);
     EXPECT_LE(g.memory.Total(), o.memory_budget);
   }
   // Without the process in the budget the groups would not have fitted.

@@ -118,12 +118,8 @@ std::vector<Eigen::Vector3d> BruteForceCandidates(const MatchGroupData& group, c
   return out;
 }
 
-// Seed matching searches only the features near each epipolar segment (a
-// bucket walk along it, clipped to the image): it must find exactly the
-// candidates a scan of every feature finds, including features just inside
-// and just outside epipolar_distance, features of the other kind on the
-// line, and segments that leave the image.
-TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
+// Two images of a plane scene (241 x 181), each the other's view.
+MatchGroupData TwoImageGroup() {
   const test::PlaneScene scene = test::MakePlaneScene(2, 241, 181, 17);
   MatchGroupData group;
   for (int i = 0; i < 2; ++i) {
@@ -133,6 +129,16 @@ TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
     image.depth = image.camera.Depth(test::GroundAt(image.camera, Eigen::Vector2d(120, 90)));
     group.images.push_back(image);
   }
+  return group;
+}
+
+// Seed matching searches only the features near each epipolar segment (a
+// bucket walk along it, clipped to the image): it must find exactly the
+// candidates a scan of every feature finds, including features just inside
+// and just outside epipolar_distance, features of the other kind on the
+// line, and segments that leave the image.
+TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
+  MatchGroupData group = TwoImageGroup();
   MatcherOptions options;
   options.candidates_per_feature = 100000;  // keep every candidate
   std::mt19937 rng(5);
@@ -206,6 +212,34 @@ TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
   // Each feature has at least its ground match and the two within 1.9 px,
   // where its segment stays over image 1.
   EXPECT_GT(candidates, 2 * static_cast<long>(features[0].size()));
+}
+
+// A view-only image (another strip's, ImageGroup::views) lends its features
+// as partners but starts no seed.
+TEST(SeedMatcherTest, AViewOnlyImageStartsNoSeed) {
+  MatchGroupData group = TwoImageGroup();
+  // The same ground point's feature in both images.
+  std::vector<std::vector<Feature>> features(2);
+  for (int k = 0; k < 20; ++k) {
+    Feature f;
+    f.uv = Eigen::Vector2d(60 + 6 * k, 60 + 3 * k);
+    features[0].push_back(f);
+    Feature g = f;
+    g.uv = group.images[1].camera.Project(test::GroundAt(group.images[0].camera, f.uv));
+    features[1].push_back(g);
+  }
+  const MatcherOptions options;
+  std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  ASSERT_FALSE(seeds.empty());
+  EXPECT_TRUE(
+      std::any_of(seeds.begin(), seeds.end(), [](const SeedFeature& s) { return s.image == 1; }));
+  group.images[1].reference = false;
+  seeds = MatchSeeds(group, features, options);
+  ASSERT_FALSE(seeds.empty());
+  for (const SeedFeature& s : seeds) {
+    EXPECT_EQ(s.image, 0);
+    for (const PatchCandidate& c : s.candidates) EXPECT_EQ(c.ref, 0);
+  }
 }
 
 }  // namespace

@@ -24,6 +24,9 @@ struct MatchImage {
   cv::Mat color;           // CV_8UC3, BGR
   std::vector<int> views;  // other images of the group to match with, best first
   double depth = 0;        // expected scene depth along the optical axis
+  // False for a view-only image (another strip's, ImageGroup::views): patches
+  // are matched in it, but no seed, patch or point takes it as reference.
+  bool reference = true;
 };
 
 struct MatchGroupData {

@@ -55,7 +55,8 @@ MatcherMemoryModel MatcherMemory() {
 
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, PatchKernels& kernels,
-                       const BlockGeometry* geometry, const MatchProgressFn& on_progress) {
+                       const BlockGeometry* geometry, const MatchProgressFn& on_progress,
+                       const std::vector<int>& view_ids) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("matcher options: expected " + problem);
   std::vector<int> ids = image_ids;
@@ -105,7 +106,10 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     stage_start = std::chrono::steady_clock::now();
   };
 
+  const size_t references = ids.size();
+  ids.insert(ids.end(), view_ids.begin(), view_ids.end());
   MatchGroupData group = LoadMatchGroup(block, ids, options.level, geometry);
+  for (size_t i = references; i < group.images.size(); ++i) group.images[i].reference = false;
   SelectViews(options, &group);
   stats.images = static_cast<int>(group.images.size());
   stats.gsd = group.gsd;

@@ -139,6 +139,7 @@ std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
   std::vector<SeedFeature> seeds;
   for (int i = 0; i < n; ++i) {
     const MatchImage& ref = group.images[i];
+    if (!ref.reference) continue;  // its features are partners only
     std::vector<SeedFeature> local(features[i].size());
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t fi = 0; fi < features[i].size(); ++fi) {

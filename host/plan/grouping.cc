@@ -167,12 +167,15 @@ double OverlapShare(const std::vector<Footprint>& fp, int i, int j) {
   return static_cast<double>(inside) / (kGrid * kGrid);
 }
 
+// Images of `ids` that overlap fewer than min_image_num - 1 others of
+// `matched_in` (ids and the group's views; ids alone when empty).
 std::vector<int> ShortOfViews(const std::vector<Footprint>& fp, const std::vector<int>& ids,
-                              int min_image_num) {
+                              int min_image_num, const std::vector<int>& matched_in = {}) {
+  const std::vector<int>& others = matched_in.empty() ? ids : matched_in;
   std::vector<int> out;
   for (const int i : ids) {
     int views = 0;
-    for (const int j : ids) views += j != i && OverlapShare(fp, i, j) >= 0.1;
+    for (const int j : others) views += j != i && OverlapShare(fp, i, j) >= 0.1;
     if (views < min_image_num - 1) out.push_back(i);
   }
   return out;
@@ -251,6 +254,54 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
       break;
     }
     if (!joined) plan->ungrouped.push_back(i);
+  }
+}
+
+// Strip groups: up to strip_views images of other strips per group, as
+// views only, those that see most of the group's footprints first (summed
+// OverlapShare, each at least 10 % of one group image), while the group fits
+// the budget. Views are re-ranked per image when matching (SelectViews), so
+// more than kMaxViews - 1 here only helps where images see different ground.
+void AddStripViews(const Block& block, const GroupingOptions& o, const std::vector<Footprint>& fp,
+                   GroupingPlan* plan) {
+  if (o.strip_views <= 0) return;
+  std::vector<int> strip_of(block.images.size(), -1);
+  for (size_t s = 0; s < plan->strips.size(); ++s)
+    for (const int i : plan->strips[s]) strip_of[i] = static_cast<int>(s);
+  for (ImageGroup& g : plan->groups) {
+    if (g.strip < 0) continue;
+    std::vector<std::pair<double, int>> ranked;
+    for (size_t j = 0; j < block.images.size(); ++j) {
+      if (!fp[j].valid || strip_of[j] == g.strip ||
+          std::find(g.images.begin(), g.images.end(), static_cast<int>(j)) != g.images.end()) {
+        continue;
+      }
+      double sum = 0, best = 0;
+      for (const int i : g.images) {
+        // Disjoint bounding boxes: no overlap, without the 7 x 7 samples.
+        if (!fp[i].valid || (fp[i].hi.array() < fp[j].lo.array()).any() ||
+            (fp[j].hi.array() < fp[i].lo.array()).any()) {
+          continue;
+        }
+        const double share = OverlapShare(fp, i, static_cast<int>(j));
+        sum += share;
+        best = std::max(best, share);
+      }
+      if (best >= 0.1) ranked.emplace_back(sum, static_cast<int>(j));
+    }
+    std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    std::vector<int> with = g.images;
+    for (const auto& [share, j] : ranked) {
+      if (static_cast<int>(g.views.size()) >= o.strip_views) break;
+      with.push_back(j);
+      if (!Fits(block, with, *plan)) {
+        with.pop_back();
+        break;
+      }
+      g.views.push_back(j);
+    }
   }
 }
 
@@ -513,9 +564,12 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     plan.single_group = true;
     return plan;
   }
+  if (options.strategy == GroupingStrategy::kStrip) AddStripViews(block, options, fp, &plan);
   for (ImageGroup& g : plan.groups) {
-    g.memory = EstimateInProcess(block, g.images, matcher, process_bytes);
-    g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num);
+    std::vector<int> all_images = g.images;
+    all_images.insert(all_images.end(), g.views.begin(), g.views.end());
+    g.memory = EstimateInProcess(block, all_images, matcher, process_bytes);
+    g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num, all_images);
   }
   return plan;
 }

@@ -47,14 +47,16 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
       << FormatBytes(o.memory_budget);
   if (plan.strategy == GroupingStrategy::kFootprint)
     out << ", tiles of " << Fixed(o.tile_size, 2) << " footprint, " << o.tile_views << " views";
+  else
+    out << ", up to " << o.strip_views << " view-only images of other strips";
   out << "\n";
   out << "groups      " << plan.groups.size();
   if (plan.single_group) out << " (single group: the block fits one, so it is not split)";
   out << "\n";
 
-  std::vector<std::array<std::string, 8>> rows;
-  rows.push_back({"group", "strip", "image numbers", "image names", "images", "centre X, Y",
-                  "device", "host"});
+  std::vector<std::array<std::string, 9>> rows;
+  rows.push_back({"group", "strip", "image numbers", "image names", "images", "views",
+                  "centre X, Y", "device", "host"});
   double largest = 0;
   for (size_t g = 0; g < plan.groups.size(); ++g) {
     const ImageGroup& grp = plan.groups[g];
@@ -62,15 +64,16 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
     for (const int i : grp.images) numbers += (numbers.empty() ? "" : " ") + std::to_string(i + 1);
     rows.push_back({std::to_string(g + 1), grp.strip < 0 ? "-" : std::to_string(grp.strip + 1),
                     numbers, NamesColumn(block, grp.images), std::to_string(grp.images.size()),
+                    std::to_string(grp.views.size()),
                     Fixed(grp.center.x(), 1) + ", " + Fixed(grp.center.y(), 1),
                     FormatBytes(grp.memory.device_bytes), FormatBytes(grp.memory.host_bytes)});
     largest = std::max(largest, grp.memory.Total());
   }
-  std::array<size_t, 8> width{};
+  std::array<size_t, 9> width{};
   for (const auto& r : rows)
     for (size_t c = 0; c < r.size(); ++c) width[c] = std::max(width[c], r[c].size());
   // Numbers right-aligned, text left-aligned; the last column unpadded.
-  const bool right[8] = {true, true, false, false, true, true, true, true};
+  const bool right[9] = {true, true, false, false, true, true, true, true, true};
   for (const auto& r : rows) {
     std::string line;
     for (size_t c = 0; c < r.size(); ++c) {
@@ -112,15 +115,20 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["strategy"] = ToString(plan.strategy);
   j["single_group"] = plan.single_group;
-  j["options"] = {{"max_images", o.max_images},  {"memory_budget", o.memory_budget},
-                  {"level", plan.matcher.level}, {"tile_size", o.tile_size},
-                  {"tile_views", o.tile_views},  {"min_image_num", plan.matcher.min_image_num}};
+  j["options"] = {{"max_images", o.max_images},
+                  {"memory_budget", o.memory_budget},
+                  {"level", plan.matcher.level},
+                  {"tile_size", o.tile_size},
+                  {"tile_views", o.tile_views},
+                  {"strip_views", o.strip_views},
+                  {"min_image_num", plan.matcher.min_image_num}};
   j["strips"] = json::array();
   for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
   j["groups"] = json::array();
   for (const ImageGroup& g : plan.groups) {
     json jg = {{"indices", g.images},
                {"names", names(g.images)},
+               {"views", {{"indices", g.views}, {"names", names(g.views)}}},
                {"strip", g.strip < 0 ? json(nullptr) : json(g.strip)},
                {"center", {g.center.x(), g.center.y()}},
                {"memory",

@@ -216,9 +216,9 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     run.memory.rss_before_bytes = CurrentRssBytes();
     run.memory.peak_of_group = ResetPeakRss();
     kernels->ResetPeakDeviceBytes();
-    MatchResult result =
-        MatchGroup(block, plan.groups[g].images, options.matcher, *kernels, &geometry,
-                   [&](const MatchProgressEvent& e) { progress.Update(e); });
+    MatchResult result = MatchGroup(
+        block, plan.groups[g].images, options.matcher, *kernels, &geometry,
+        [&](const MatchProgressEvent& e) { progress.Update(e); }, plan.groups[g].views);
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
     run.memory.peak_rss_bytes = PeakRssBytes();

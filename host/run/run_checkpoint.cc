@@ -25,13 +25,17 @@ nlohmann::json ReadJson(const std::filesystem::path& path) {
 
 nlohmann::json PlanRecord(const Block& block, const GroupingPlan& plan,
                           const MatcherOptions& matcher) {
-  nlohmann::json groups = nlohmann::json::array();
+  nlohmann::json groups = nlohmann::json::array(), views = nlohmann::json::array();
+  auto names = [&](const std::vector<int>& ids) {
+    nlohmann::json n = nlohmann::json::array();
+    for (const int i : ids) n.push_back(block.images[i].name);
+    return n;
+  };
   for (const ImageGroup& g : plan.groups) {
-    nlohmann::json names = nlohmann::json::array();
-    for (const int i : g.images) names.push_back(block.images[i].name);
-    groups.push_back(names);
+    groups.push_back(names(g.images));
+    views.push_back(names(g.views));
   }
-  return {{"groups", groups}, {"matcher", OptionsJson(matcher)}};
+  return {{"groups", groups}, {"views", views}, {"matcher", OptionsJson(matcher)}};
 }
 
 // group_NNN.ply or group_NNN.json, as CloudPath/StatusPath name them.

@@ -29,7 +29,8 @@ struct MatchResult {
 };
 
 // Matches images `image_ids` of `block` (all when empty) with `kernels`
-// (MakePatchKernels). `geometry`:
+// (MakePatchKernels); `view_ids` are matched in as views only, never as a
+// patch's reference (ImageGroup::views). `geometry`:
 // EstimateBlockGeometry(block) when the caller already has it, else nullptr.
 // `on_progress` hears each stage and wave; without it, options.progress
 // draws a status line of its own on a terminal. Throws Error for bad
@@ -37,7 +38,8 @@ struct MatchResult {
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, PatchKernels& kernels,
                        const BlockGeometry* geometry = nullptr,
-                       const MatchProgressFn& on_progress = {});
+                       const MatchProgressFn& on_progress = {},
+                       const std::vector<int>& view_ids = {});
 
 // What matching one group holds, per unit, for the planner's memory model
 // (grouping.h EstimateGroupMemory, which spells out each term): per pixel of

@@ -70,6 +70,9 @@ struct ImageGroup {
   std::vector<int> images;  // indices into block.images, in flight order (strip)
                             // or best view first (footprint)
   int strip = -1;           // strip index (strip strategy), else -1
+  // Images of other strips the group's patches are also matched in, never as
+  // a reference (GroupingOptions::strip_views), most overlap first.
+  std::vector<int> views;
   // Local-frame XY of the group's ground centre: the mean of its images'
   // footprint centres (strip), the tile centre (footprint). The merge gives
   // each XY to the group with the nearest center.

@@ -33,6 +33,13 @@ struct GroupingOptions {
   // of the tile is seen by this many of them (or max_images is reached),
   // >= 2.
   int tile_views = 4;
+  // Strip strategy: each group also takes up to this many images of other
+  // strips that see its ground, as views only: its patches are matched in
+  // them, but no seed, patch or point has one as its reference, so the work
+  // and the merge stay the paper's runs. A run alone sees the ground near a
+  // strip's ends and edges in fewer than min_image_num images. >= 0 (0 = the
+  // paper's runs alone).
+  int strip_views = 2;
 
   // Logs the first failing condition to stderr and returns false.
   bool Check() const;
@@ -73,6 +80,13 @@ void VisitFields(GroupingOptions& o, F&& f) {
         .Unit("images")
         .Range(AtLeast(2))
         .Help("footprint: images a tile's points should be seen in"));
+  f(Field(o.strip_views, "strip_views")
+        .Flag("--strip-views")
+        .In(s)
+        .Unit("images")
+        .Range(AtLeast(0))
+        .Help("strip: images of other strips each group matches in as views only, most "
+              "overlap first (0 = the paper's runs alone)"));
 }
 
 }  // namespace sapmvs
