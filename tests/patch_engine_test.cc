@@ -139,6 +139,49 @@ TEST_F(PatchEngineTest, RejectsSeedsWithTooFewViewsOrFacingAway) {
   for (const auto& r : engine.Evaluate(TiltedSeeds(scene, 4, 0.0, 0.0, 94))) EXPECT_FALSE(r);
 }
 
+// Another strip's images (view-only, ImageGroup::views) only bring a
+// patch's views among the group's own images up to min_image_num: with
+// min_image_num 3 a patch that two own images see takes one of them and no
+// patch has more than 3 views; with min_image_num 5 a patch needs both, and
+// is accepted only thanks to them.
+TEST_F(PatchEngineTest, ViewOnlyImagesOnlyFillUpToMinImageNum) {
+  const PlaneScene scene = MakePlaneScene(5, 201, 161, 97);
+  MatchGroupData group = GroupOf(scene);
+  group.images[3].reference = group.images[4].reference = false;
+  const std::vector<PatchCandidate> seeds = TiltedSeeds(scene, 6, 0.0, 0.0, 98);
+  auto view_only = [](const AcceptedPatch& a) {
+    return std::count_if(a.views.begin(), a.views.end(), [](int v) { return v >= 3; });
+  };
+  MatcherOptions options;
+  {
+    PatchEngine engine(NewKernels(), group, options);
+    int with_one = 0;
+    for (const auto& r : engine.Evaluate(seeds)) {
+      ASSERT_TRUE(r);
+      EXPECT_LE(r->views.size(), 3u);
+      with_one += view_only(*r) == 1;
+    }
+    EXPECT_GT(with_one, 0);
+  }
+  options.min_image_num = 5;
+  PatchEngine engine(NewKernels(), group, options);
+  int accepted = 0;
+  for (const auto& r : engine.Evaluate(seeds)) {
+    if (!r) continue;
+    ++accepted;
+    EXPECT_EQ(view_only(*r), 2);
+  }
+  EXPECT_GT(accepted, 0);
+  // Without them, 3 images cannot give 4 views.
+  MatchGroupData own = group;
+  for (MatchImage& im : own.images) {
+    im.views.erase(std::remove_if(im.views.begin(), im.views.end(), [](int v) { return v >= 3; }),
+                   im.views.end());
+  }
+  PatchEngine without(NewKernels(), own, options);
+  for (const auto& r : without.Evaluate(seeds)) EXPECT_FALSE(r);
+}
+
 // The paper's narrow baselines: 5 images 4 degrees apart along a strip
 // (2.8 m at 40 m). Every view of the middle image is narrower than
 // max_angle (10 degrees), yet the views on either side of it are 12 to 16

@@ -116,14 +116,22 @@ bool PatchEngine::OnParentPlane(const PatchCandidate& candidate,
 std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
                                            const Eigen::Vector3d& normal, int ref, int half) const {
   const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
-  std::vector<int> views;
+  std::vector<int> views, view_only;
   for (const int v : group_.images[ref].views) {
     const Camera& cam = group_.images[v].camera;
     if (!(cam.Depth(center) > 0)) continue;
     if (!cam.InImage(cam.Project(center), half + 1)) continue;
     const Eigen::Vector3d to_cam = (cam.center() - center).normalized();
     if (normal.dot(to_cam) < cos_max) continue;
-    views.push_back(v);
+    (group_.images[v].reference ? views : view_only).push_back(v);
+  }
+  // Another strip's images only to bring the group's own up to
+  // min_image_num, best first: at campus's 92 % forward overlap all of them
+  // only added views to patches that had enough (34 % more time for 2.6
+  // points of coverage), and at small's 70 % every patch took both (39 %).
+  for (size_t k = 0; k < view_only.size(); ++k) {
+    if (static_cast<int>(views.size()) >= options_.min_image_num) break;
+    views.push_back(view_only[k]);
   }
   return views;
 }
