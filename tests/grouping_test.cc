@@ -521,9 +521,9 @@ TEST(GroupingMemory, TheProcessCountsInEveryGroupAndInTheBudget) {
             (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
   for (const ImageGroup& g : with.groups) {
     EXPECT_EQ(g.memory.process_bytes, counted);
-    std::vector<int> loaded = g.images;  // view-only images are loaded too
-    loaded.insert(loaded.end(), g.views.begin(), g.views.end());
-    EXPECT_DOUBLE_EQ(g.memory.Total(), EstimateGroupMemory(s.block, loaded, 1).Total() + counted);
+    // View-only images are loaded too.
+    EXPECT_DOUBLE_EQ(g.memory.Total(),
+                     EstimateGroupMemory(s.block, g.MatchedIn(), 1).Total() + counted);
     EXPECT_LE(g.memory.Total(), o.memory_budget);
   }
   // Without the process in the budget the groups would not have fitted.

@@ -20,11 +20,16 @@ Dem Dem::Load(const std::filesystem::path& path) {
   // GTiff decodes the blocks of one RasterIO call on all cores (GDAL >= 3.6;
   // other drivers and older versions ignore it, and a config option, unlike
   // an open option, warns for none): a simulated block's DEM is its 0.11 m
-  // truth, 23 M deflated cells, 0.5 s of every run on one core.
-  CPLSetThreadLocalConfigOption("GDAL_NUM_THREADS", "ALL_CPUS");
+  // truth, 23 M deflated cells, 0.5 s of every run on one core. A user's own
+  // GDAL_NUM_THREADS (environment or config) is left to rule.
+  const bool set_threads = CPLGetConfigOption("GDAL_NUM_THREADS", nullptr) == nullptr;
+  if (set_threads) CPLSetThreadLocalConfigOption("GDAL_NUM_THREADS", "ALL_CPUS");
   struct ResetThreads {
-    ~ResetThreads() { CPLSetThreadLocalConfigOption("GDAL_NUM_THREADS", nullptr); }
-  } reset_threads;
+    bool set;
+    ~ResetThreads() {
+      if (set) CPLSetThreadLocalConfigOption("GDAL_NUM_THREADS", nullptr);
+    }
+  } reset_threads{set_threads};
   std::unique_ptr<GDALDataset> ds(
       GDALDataset::Open(path.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
   if (!ds) throw Error(path.string() + ": cannot read elevation raster");

@@ -129,9 +129,9 @@ std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
   // min_image_num, best first: at campus's 92 % forward overlap all of them
   // only added views to patches that had enough (34 % more time for 2.6
   // points of coverage), and at small's 70 % every patch took both (39 %).
-  for (size_t k = 0; k < view_only.size(); ++k) {
+  for (const int v : view_only) {
     if (static_cast<int>(views.size()) >= options_.min_image_num) break;
-    views.push_back(view_only[k]);
+    views.push_back(v);
   }
   return views;
 }

@@ -168,14 +168,13 @@ double OverlapShare(const std::vector<Footprint>& fp, int i, int j) {
 }
 
 // Images of `ids` that overlap fewer than min_image_num - 1 others of
-// `matched_in` (ids and the group's views; ids alone when empty).
+// `matched_in` (ImageGroup::MatchedIn: ids and the group's views).
 std::vector<int> ShortOfViews(const std::vector<Footprint>& fp, const std::vector<int>& ids,
-                              int min_image_num, const std::vector<int>& matched_in = {}) {
-  const std::vector<int>& others = matched_in.empty() ? ids : matched_in;
+                              int min_image_num, const std::vector<int>& matched_in) {
   std::vector<int> out;
   for (const int i : ids) {
     int views = 0;
-    for (const int j : others) views += j != i && OverlapShare(fp, i, j) >= 0.1;
+    for (const int j : matched_in) views += j != i && OverlapShare(fp, i, j) >= 0.1;
     if (views < min_image_num - 1) out.push_back(i);
   }
   return out;
@@ -558,7 +557,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
       all.memory.Total() <= options.memory_budget) {
     for (const int i : all.images) all.center += fp[i].center;
     all.center /= static_cast<double>(all.images.size());
-    all.short_of_views = ShortOfViews(fp, all.images, matcher.min_image_num);
+    all.short_of_views = ShortOfViews(fp, all.images, matcher.min_image_num, all.images);
     plan.groups.assign(1, all);
     plan.ungrouped.clear();
     plan.single_group = true;
@@ -566,10 +565,9 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   }
   if (options.strategy == GroupingStrategy::kStrip) AddStripViews(block, options, fp, &plan);
   for (ImageGroup& g : plan.groups) {
-    std::vector<int> all_images = g.images;
-    all_images.insert(all_images.end(), g.views.begin(), g.views.end());
-    g.memory = EstimateInProcess(block, all_images, matcher, process_bytes);
-    g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num, all_images);
+    const std::vector<int> matched_in = g.MatchedIn();
+    g.memory = EstimateInProcess(block, matched_in, matcher, process_bytes);
+    g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num, matched_in);
   }
   return plan;
 }

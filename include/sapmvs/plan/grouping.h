@@ -73,6 +73,12 @@ struct ImageGroup {
   // Images of other strips the group's patches are also matched in, never as
   // a reference (GroupingOptions::strip_views), most overlap first.
   std::vector<int> views;
+  // images, then views: every image the group loads and matches in.
+  std::vector<int> MatchedIn() const {
+    std::vector<int> all = images;
+    all.insert(all.end(), views.begin(), views.end());
+    return all;
+  }
   // Local-frame XY of the group's ground centre: the mean of its images'
   // footprint centres (strip), the tile centre (footprint). The merge gives
   // each XY to the group with the nearest center.
