@@ -89,20 +89,8 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_s
         !window_projection(cameras[pair.y], win, c, n, &gb)) {
       continue;
     }
-    bool valid = true;
-    for (int r = 0; r < PATCH_SIZE && valid; ++r) {
-      for (int col = 0; col < PATCH_SIZE; ++col) {
-        const float vb = sample_grid(images, image_table, pair.y, gb, (float)(r - half_size),
-                                     (float)(col - half_size));
-        // One NaN sample (outside, behind, or a NaN pixel) voids the pair.
-        if (isnan(vb)) {
-          valid = false;
-          break;
-        }
-        b[r * PATCH_SIZE + col] = vb;
-      }
-    }
-    if (valid) {
+    // One NaN sample (outside, behind, or a NaN pixel) voids the pair.
+    if (sample_view(images, image_table, pair.y, gb, b)) {
       scores[i] = ncc_against(a, sum_w, saa, b, w);
     }
   }

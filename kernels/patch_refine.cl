@@ -7,7 +7,7 @@
 // schedule and tie rules.
 //
 // The NCC primitives (NccCamera, NccPatch, bilinear_at, sample_image,
-// project_grid, sample_grid, ncc_of, ncc_weights) come from ncc.cl, as in
+// window_projection, sample_view, ncc_against, ncc_weights) come from ncc.cl, as in
 // ncc_score.cl. The grid geometry of patch_views_ncc is that of the
 // ncc_score kernel body.
 //
@@ -61,24 +61,13 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
   if (!plane_seen(cameras[reference], c, n)) {
     return NAN;
   }
-  const int half_size = PATCH_SIZE / 2;
   float sum = 0.0f;
   bool all_valid = true;
   float b[NCC_NUM_SAMPLES];
   for (int v = 0; v < num_views && (all || all_valid); ++v) {
     GridProjection gb;
-    bool valid = window_projection(cameras[views[v]], win, c, n, &gb);
-    for (int r = 0; r < PATCH_SIZE && valid; ++r) {
-      for (int col = 0; col < PATCH_SIZE; ++col) {
-        const float vb = sample_grid(images, table, views[v], gb, (float)(r - half_size),
-                                     (float)(col - half_size));
-        if (isnan(vb)) {
-          valid = false;
-          break;
-        }
-        b[r * PATCH_SIZE + col] = vb;
-      }
-    }
+    const bool valid = window_projection(cameras[views[v]], win, c, n, &gb) &&
+                       sample_view(images, table, views[v], gb, b);
     nccs[v] = valid ? ncc_against(da, sum_w, saa, b, w) : NAN;
     if (isnan(nccs[v])) {
       all_valid = false;
