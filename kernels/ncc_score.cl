@@ -81,7 +81,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void ncc_s
   if (!ncc_centre(a, w, &sum_w, &saa)) {
     return;
   }
-  float b[NCC_NUM_SAMPLES];
+  float b[NCC_SAMPLE_BUFFER];
   for (int i = first; i < end; ++i) {
     const int2 pair = pairs[i];
     GridProjection gb;

@@ -63,7 +63,7 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
   }
   float sum = 0.0f;
   bool all_valid = true;
-  float b[NCC_NUM_SAMPLES];
+  float b[NCC_SAMPLE_BUFFER];
   for (int v = 0; v < num_views && (all || all_valid); ++v) {
     GridProjection gb;
     const bool valid = window_projection(cameras[views[v]], win, c, n, &gb) &&

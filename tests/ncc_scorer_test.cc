@@ -311,6 +311,51 @@ TEST_F(NccScorerTest, FlatImageAndBehindCameraGiveNaN) {
   }
 }
 
+// A NaN pixel under a view's window voids the pair also where the window
+// lies wholly inside the view, whose samples sample_view (ncc.cl) reads
+// without checking them one by one: at the window's centre and at its corner
+// sample. The untouched patch keeps its score.
+TEST_F(NccScorerTest, NaNPixelVoidsThePairInsideTheImage) {
+  PlaneScene scene = MakePlaneScene(2, 161, 123, 61);
+  const Camera& ref = scene.cameras[0];
+  const Camera& view = scene.cameras[1];
+  const int half = kDefaultPatchSize / 2;
+  // Patch centre in the reference, and the reference offset whose ground
+  // point gets the NaN pixels in the view (none for the last patch).
+  const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> cases = {
+      {{60, 50}, {0, 0}}, {{100, 70}, {half, half}}, {{80, 40}, {kNaN, kNaN}}};
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  for (const auto& [uv, offset] : cases) {
+    const Eigen::Vector3d center = GroundAt(ref, uv);
+    patches.push_back(MakeNccPatch(center, Eigen::Vector3d::UnitZ(), 0));
+    pairs.push_back({static_cast<int>(patches.size()) - 1, 1});
+    if (std::isnan(offset.x())) continue;
+    const Eigen::Vector2d at = view.Project(GroundAt(ref, uv + offset));
+    ASSERT_TRUE(view.InImage(at, 2 * half + 2)) << at.transpose();
+    // The whole 2 x 2 support of the sample.
+    for (int dy = 0; dy <= 1; ++dy) {
+      for (int dx = 0; dx <= 1; ++dx) {
+        const int x = static_cast<int>(std::floor(at.x())) + dx;
+        const int y = static_cast<int>(std::floor(at.y())) + dy;
+        scene.pixels[1][static_cast<size_t>(y) * view.width() + x] = kNaN;
+      }
+    }
+  }
+  NccScorer scorer(context());
+  scorer.SetGroup(scene.group);
+  const std::vector<float> scores = scorer.Score(patches, pairs);
+  const std::vector<double> expected =
+      NccScoreReference(scene.group, patches, pairs, kDefaultPatchSize);
+  ASSERT_EQ(scores.size(), 3u);
+  EXPECT_TRUE(std::isnan(scores[0]));
+  EXPECT_TRUE(std::isnan(scores[1]));
+  EXPECT_TRUE(std::isnan(expected[0]));
+  EXPECT_TRUE(std::isnan(expected[1]));
+  EXPECT_GT(scores[2], 0.9f);
+  EXPECT_TRUE(NearAbsRel(scores[2], expected[2], kAbsTol, kRelTol));
+}
+
 // The grid spans the same reference pixels however the plane is tilted (as
 // PMVS2's getPAxes): a patch 5 px below the top border, its plane turned
 // about the reference x axis away from facing the camera, keeps its top
