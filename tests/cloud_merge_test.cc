@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "sapmvs/util/error.h"
@@ -156,6 +157,74 @@ TEST(CloudMerge, SameInputsGiveTheSameOutput) {
   for (size_t i = 0; i < m1.points.size(); ++i) {
     EXPECT_EQ(m1.points[i].position, m2.points[i].position);
   }
+}
+
+// The merge keeps, in order of core first and then score, each point with
+// no kept point of another group within the radius. Checked pair by pair
+// against every kept point on three groups: two that overlap in a band and
+// one apart, whose points the merge keeps without looking them up.
+TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double boxes[3][2] = {{0, 10}, {8, 18}, {30, 40}};  // x ranges; y in [0, 10]
+  std::vector<PointCloud> clouds(3);
+  for (int g = 0; g < 3; ++g) {
+    for (int i = 0; i < 500; ++i) {
+      CloudPoint p;
+      const double x = boxes[g][0] + (boxes[g][1] - boxes[g][0]) * u(rng);
+      p.position = {500000.0 + x, 5400000.0 + 10 * u(rng), 0.2 * u(rng)};
+      p.score = static_cast<float>(u(rng));
+      clouds[g].points.push_back(p);
+    }
+  }
+  std::vector<GroupCloud> groups;
+  for (int g = 0; g < 3; ++g) {
+    groups.push_back({&clouds[g], {500000.0 + 0.5 * (boxes[g][0] + boxes[g][1]), 5400005.0}});
+  }
+  MergeOptions o;
+  o.radius = 0.3;
+  MergeStats stats;
+  const std::vector<MergedRef> merged = MergeGroupRefs(groups, o, &stats);
+
+  struct Item {
+    int group;
+    size_t index;
+    bool core;
+    float score;
+  };
+  std::vector<Eigen::Vector2d> centers;
+  for (const GroupCloud& g : groups) centers.push_back(g.center);
+  std::vector<Item> items;
+  for (int g = 0; g < 3; ++g) {
+    for (size_t i = 0; i < clouds[g].points.size(); ++i) {
+      const Eigen::Vector3d& p = clouds[g].points[i].position;
+      items.push_back({g, i, CoreOwner(centers, p.x(), p.y()) == g, clouds[g].points[i].score});
+    }
+  }
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    return a.core != b.core ? a.core : a.score > b.score;
+  });
+  std::vector<Item> kept;
+  for (const Item& item : items) {
+    const Eigen::Vector3d& p = clouds[item.group].points[item.index].position;
+    const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Item& k) {
+      return k.group != item.group &&
+             (clouds[k.group].points[k.index].position - p).squaredNorm() <= o.radius * o.radius;
+    });
+    if (!duplicate) kept.push_back(item);
+  }
+  std::sort(kept.begin(), kept.end(), [](const Item& a, const Item& b) {
+    return a.group != b.group ? a.group < b.group : a.index < b.index;
+  });
+  ASSERT_EQ(merged.size(), kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_EQ(merged[i].group, kept[i].group) << i;
+    EXPECT_EQ(merged[i].index, kept[i].index) << i;
+    EXPECT_EQ(merged[i].core, kept[i].core) << i;
+  }
+  // Duplicates occurred, and the lone group kept every point.
+  EXPECT_GT(stats.duplicates, 20);
+  EXPECT_EQ(stats.kept_by_group[2], 500);
 }
 
 TEST(CloudMerge, BadRadiusIsAnError) {

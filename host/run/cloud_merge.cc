@@ -104,6 +104,62 @@ struct Ref {
   size_t index;
 };
 
+// Side of the coarse columns, in merge radii.
+constexpr double kCoarseCell = 8.0;
+
+// For each point of each group (in group order, then point order): whether a
+// point of another group may lie within `radius` of it. Coarse columns of
+// side kCoarseCell radii record which groups have points in them; a point
+// none of whose columns within the radius holds another group's points has
+// no duplicate and is nobody's, so the greedy pass keeps it without a lookup
+// in its fine grid, and the result is the same. Conservative: "may" is by
+// column. The fine grid's 27 hash lookups per point were most of the merge's
+// time: `small`'s merge stage took 0.82-0.88 s with them for every point,
+// 0.35-0.44 s with them for the contested ones.
+std::vector<uint8_t> MayHaveForeignNeighbour(const std::vector<GroupCloud>& groups, double radius) {
+  struct Column {
+    int group = -1;  // the first group seen in it
+    bool mixed = false;
+  };
+  const double side = kCoarseCell * radius;
+  auto key = [&](double x, double y) {
+    return CellKey{static_cast<int64_t>(std::floor(x / side)),
+                   static_cast<int64_t>(std::floor(y / side)), 0};
+  };
+  std::unordered_map<CellKey, Column, CellHash> columns;
+  size_t total = 0;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    for (const CloudPoint& p : groups[g].cloud->points) {
+      Column& c = columns[key(p.position.x(), p.position.y())];
+      if (c.group < 0) c.group = static_cast<int>(g);
+      if (c.group != static_cast<int>(g)) c.mixed = true;
+    }
+    total += groups[g].cloud->points.size();
+  }
+  std::vector<uint8_t> may(total, 0);
+  size_t first = 0;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const auto& pts = groups[g].cloud->points;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < pts.size(); ++i) {
+      const Eigen::Vector3d& p = pts[i].position;
+      const CellKey lo = key(p.x() - radius, p.y() - radius);
+      const CellKey hi = key(p.x() + radius, p.y() + radius);
+      bool foreign = false;
+      for (int64_t x = lo.x; x <= hi.x && !foreign; ++x) {
+        for (int64_t y = lo.y; y <= hi.y && !foreign; ++y) {
+          const auto it = columns.find(CellKey{x, y, 0});
+          foreign =
+              it != columns.end() && (it->second.mixed || it->second.group != static_cast<int>(g));
+        }
+      }
+      may[first + i] = foreign;
+    }
+    first += pts.size();
+  }
+  return may;
+}
+
 }  // namespace
 
 std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
@@ -137,16 +193,19 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   struct Item {
     Ref ref;
     bool core;
+    bool contested;  // MayHaveForeignNeighbour
     float score;
   };
+  const std::vector<uint8_t> contested = MayHaveForeignNeighbour(groups, options.radius);
   std::vector<Item> items;
+  size_t flat = 0;
   for (size_t g = 0; g < groups.size(); ++g) {
     const auto& pts = groups[g].cloud->points;
     st.input += static_cast<long>(pts.size());
-    for (size_t i = 0; i < pts.size(); ++i) {
+    for (size_t i = 0; i < pts.size(); ++i, ++flat) {
       const bool core =
           CoreOwner(centers, pts[i].position.x(), pts[i].position.y()) == static_cast<int>(g);
-      items.push_back({{static_cast<int>(g), i}, core, pts[i].score});
+      items.push_back({{static_cast<int>(g), i}, core, contested[flat] != 0, pts[i].score});
     }
   }
   // Core points first so that the owner's surface wins; then the better match.
@@ -161,15 +220,17 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   };
   RadiusGrid<Ref> kept(options.radius);
   for (const Item& item : items) {
-    const Eigen::Vector3d& p = point(item.ref).position;
-    const bool duplicate = kept.AnyNear(p, [&](const Ref& other) {
-      return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
-    });
-    if (duplicate) {
-      ++st.duplicates;
-      continue;
+    if (item.contested) {
+      const Eigen::Vector3d& p = point(item.ref).position;
+      const bool duplicate = kept.AnyNear(p, [&](const Ref& other) {
+        return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
+      });
+      if (duplicate) {
+        ++st.duplicates;
+        continue;
+      }
+      kept.Insert(p, item.ref);
     }
-    kept.Insert(p, item.ref);
     order.push_back({item.ref.group, item.ref.index, item.core});
     ++st.kept_by_group[item.ref.group];
     if (item.core) ++st.core_by_group[item.ref.group];
