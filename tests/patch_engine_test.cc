@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <set>
+#include <tuple>
 #include <vector>
 
 #include "cl_test_fixture.h"
@@ -117,6 +119,78 @@ TEST_F(PatchEngineTest, FlatGroundGrowsToTheLargestSizeFromATiltedStart) {
   for (const auto& r : pmvs.Evaluate(seeds)) {
     ASSERT_TRUE(r);
     EXPECT_EQ(r->size, options.window_size);
+  }
+}
+
+// Forwards to a backend and records the options of every launch.
+class RecordingKernels : public PatchKernels {
+ public:
+  explicit RecordingKernels(PatchKernels& inner) : inner_(inner) {}
+  const KernelDevice& device() const override { return inner_.device(); }
+  void SetGroup(const NccGroup& group) override { inner_.SetGroup(group); }
+  void ClearGroup() override { inner_.ClearGroup(); }
+  std::vector<float> Score(const NccScorerOptions& options, const std::vector<NccPatch>& patches,
+                           const std::vector<NccPair>& pairs, double* seconds) override {
+    scorers.push_back(options);
+    return inner_.Score(options, patches, pairs, seconds);
+  }
+  std::vector<RefinedPatch> Refine(const PatchRefinerOptions& options,
+                                   const std::vector<NccPatch>& patches,
+                                   const std::vector<std::vector<int>>& views,
+                                   double* seconds) override {
+    refiners.push_back(options);
+    return inner_.Refine(options, patches, views, seconds);
+  }
+  std::vector<NccScorerOptions> scorers;
+  std::vector<PatchRefinerOptions> refiners;
+
+ private:
+  PatchKernels& inner_;
+};
+
+auto KeyOf(const NccScorerOptions& o) {
+  return std::make_tuple(o.patch_size, o.work_group_size, o.sigma_color, o.sample_step);
+}
+auto KeyOf(const PatchRefinerOptions& o) {
+  return std::make_tuple(o.patch_size, o.work_group_size, o.iterations, o.max_halvings,
+                         o.depth_step, o.angle_step_deg, o.max_angle_deg, o.sigma_color,
+                         o.sample_step);
+}
+
+// The distinct variants among `launched` (-1 when one is not in `variants`).
+template <typename Options>
+int VariantsWithin(const std::vector<Options>& launched, const std::vector<Options>& variants) {
+  std::set<decltype(KeyOf(Options{}))> used, prepared;
+  for (const Options& o : variants) prepared.insert(KeyOf(o));
+  for (const Options& o : launched) {
+    if (!prepared.count(KeyOf(o))) return -1;
+    used.insert(KeyOf(o));
+  }
+  return static_cast<int>(used.size());
+}
+
+// MatchGroup builds EngineKernelVariants' programs ahead of the engine
+// (PatchKernels::Prepare): the engine must launch none other, in either
+// mode. Here every seed grows to 21 x 21, so sapmvs mode launches the 7 x 7
+// and the 21 x 21 variants (and would the others for seeds that stop between).
+TEST_F(PatchEngineTest, LaunchesOnlyTheVariantsPreparedForIt) {
+  const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
+  const MatchGroupData group = GroupOf(scene);
+  MatcherOptions options;
+  options.max_angle_deg = 5.0;  // as above
+  for (const MatchMode mode : {MatchMode::kSapmvs, MatchMode::kPmvs}) {
+    options.mode = mode;
+    RecordingKernels kernels(NewKernels());
+    {
+      PatchEngine engine(kernels, group, options);
+      engine.Evaluate(TiltedSeeds(scene, 12, 1.0, 6.0, 92));
+    }
+    const EngineKernels variants = EngineKernelVariants(options);
+    const bool sapmvs = mode == MatchMode::kSapmvs;
+    EXPECT_EQ(variants.scorers.size(), sapmvs ? 4u : 1u);
+    EXPECT_EQ(variants.refiners.size(), sapmvs ? 4u : 1u);
+    EXPECT_EQ(VariantsWithin(kernels.scorers, variants.scorers), sapmvs ? 2 : 1);
+    EXPECT_EQ(VariantsWithin(kernels.refiners, variants.refiners), sapmvs ? 2 : 1);
   }
 }
 

@@ -1,5 +1,6 @@
 #include "device/cl_patch_kernels.h"
 
+#include <exception>
 #include <map>
 #include <string>
 #include <tuple>
@@ -61,6 +62,24 @@ class ClPatchKernels : public PatchKernels {
     refiners_.clear();
     group_.reset();
     cameras_.clear();
+  }
+
+  void Prepare(const std::vector<NccScorerOptions>& scorers,
+               const std::vector<PatchRefinerOptions>& refiners) override {
+    // The context caches each program for the scorers and refiners that
+    // later launches make; these are only built to fill that cache.
+    for (const NccScorerOptions& o : scorers) {
+      try {
+        NccScorer scorer(context_, o);
+      } catch (const std::exception&) {  // the launch reports it
+      }
+    }
+    for (const PatchRefinerOptions& o : refiners) {
+      try {
+        PatchRefiner refiner(context_, o);
+      } catch (const std::exception&) {  // the launch reports it
+      }
+    }
   }
 
   std::vector<float> Score(const NccScorerOptions& options, const std::vector<NccPatch>& patches,

@@ -27,32 +27,69 @@ WindowGrid SampledWindow(int side, int window_size, double max_step) {
   return {2 * intervals + 1, static_cast<double>(half) / intervals};
 }
 
-double PatchEngine::SigmaColor() const {
-  if (options_.mode != MatchMode::kSapmvs) return 0.0;
-  return options_.ncc_sigma_color;
+namespace {
+
+// The NCC sample weights (MatcherOptions::ncc_sigma_color; 0 in pmvs mode).
+double SigmaColorOf(const MatcherOptions& options) {
+  return options.mode == MatchMode::kSapmvs ? options.ncc_sigma_color : 0.0;
 }
+
+PatchRefinerOptions RefineOptionsOf(const MatcherOptions& options) {
+  PatchRefinerOptions ro;
+  ro.patch_size = options.window_size;
+  ro.sigma_color = SigmaColorOf(options);
+  return ro;
+}
+
+// By patch side: the polish of each larger adaptive size (sapmvs mode).
+std::map<int, PatchRefinerOptions> PolishOptionsOf(const MatcherOptions& options) {
+  std::map<int, PatchRefinerOptions> polish;
+  if (options.mode != MatchMode::kSapmvs) return polish;
+  for (const int size : options.adaptive_sizes) {
+    if (size <= options.window_size) continue;
+    PatchRefinerOptions po;
+    const WindowGrid grid = SampledWindow(size, options.window_size, options.adaptive_sample_step);
+    po.patch_size = grid.samples;
+    po.sample_step = grid.step;
+    po.iterations = kPolishIterations;
+    po.depth_step = kPolishDepthStep;
+    po.angle_step_deg = kPolishAngleStepDeg;
+    po.sigma_color = SigmaColorOf(options);
+    polish[size] = po;
+  }
+  return polish;
+}
+
+NccScorerOptions ScoreOptionsOf(const MatcherOptions& options, int size) {
+  NccScorerOptions so;
+  so.patch_size = size;
+  so.sigma_color = SigmaColorOf(options);
+  return so;
+}
+
+}  // namespace
+
+EngineKernels EngineKernelVariants(const MatcherOptions& options) {
+  EngineKernels k;
+  k.scorers.push_back(ScoreOptionsOf(options, options.window_size));
+  k.refiners.push_back(RefineOptionsOf(options));
+  for (const auto& [size, polish] : PolishOptionsOf(options)) {
+    k.scorers.push_back(ScoreOptionsOf(options, size));
+    k.refiners.push_back(polish);
+  }
+  return k;
+}
+
+double PatchEngine::SigmaColor() const { return SigmaColorOf(options_); }
 
 PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
                          const MatcherOptions& options)
-    : kernels_(kernels), group_(group), options_(options) {
+    : kernels_(kernels),
+      group_(group),
+      options_(options),
+      refine_options_(RefineOptionsOf(options)),
+      polish_options_(PolishOptionsOf(options)) {
   kernels_.SetGroup(group_.ncc);
-  refine_options_.patch_size = options_.window_size;
-  refine_options_.sigma_color = SigmaColor();
-  if (options_.mode == MatchMode::kSapmvs) {
-    for (const int size : options_.adaptive_sizes) {
-      if (size <= options_.window_size) continue;
-      PatchRefinerOptions po;
-      const WindowGrid grid =
-          SampledWindow(size, options_.window_size, options_.adaptive_sample_step);
-      po.patch_size = grid.samples;
-      po.sample_step = grid.step;
-      po.iterations = kPolishIterations;
-      po.depth_step = kPolishDepthStep;
-      po.angle_step_deg = kPolishAngleStepDeg;
-      po.sigma_color = SigmaColor();
-      polish_options_[size] = po;
-    }
-  }
 }
 
 PatchEngine::~PatchEngine() { kernels_.ClearGroup(); }
@@ -90,9 +127,7 @@ void PatchEngine::Count(const std::string& kernel, int patch_size, long items,
 std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& patches,
                                         const std::vector<NccPair>& pairs) {
   if (pairs.empty()) return {};
-  NccScorerOptions so;
-  so.patch_size = size;
-  so.sigma_color = SigmaColor();
+  const NccScorerOptions so = ScoreOptionsOf(options_, size);
   double seconds = 0;
   std::vector<float> scores = kernels_.Score(so, patches, pairs, &seconds);
   Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size), size,

@@ -66,6 +66,15 @@ struct WindowGrid {
 };
 WindowGrid SampledWindow(int side, int window_size, double max_step);
 
+// The kernel variants (one program each) an engine with these options
+// launches: the scores at window_size and at each larger adaptive size, the
+// refinement, and each size's polish.
+struct EngineKernels {
+  std::vector<NccScorerOptions> scorers;
+  std::vector<PatchRefinerOptions> refiners;
+};
+EngineKernels EngineKernelVariants(const MatcherOptions& options);
+
 class PatchEngine {
  public:
   // Hands `group` to `kernels` (PatchKernels::SetGroup) until the engine is

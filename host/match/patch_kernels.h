@@ -49,6 +49,13 @@ class PatchKernels {
   // Lets go of the group (and the device memory that holds it).
   virtual void ClearGroup() = 0;
 
+  // Builds what launches with these options need (on a device, their
+  // programs), so that the first launches need not wait for it. May run on
+  // another thread while the caller makes no other call on this object;
+  // failures are left for the launch that needs the program to report.
+  virtual void Prepare(const std::vector<NccScorerOptions>& /*scorers*/,
+                       const std::vector<PatchRefinerOptions>& /*refiners*/) {}
+
   // Device memory this backend holds, bytes, at its peak since
   // ResetPeakDeviceBytes (the group's images and the largest batch): what a
   // GPU must have free. 0 for the reference, whose memory is the host's.
