@@ -261,18 +261,24 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   for (size_t a = 0; a < alive.size(); ++a) {
     const DensePoint& p = points[alive[a]];
     const double fp = footprint[a];
-    std::vector<Eigen::Vector3d> nbr;
+    // The neighbours in nn's order, without a per-point allocation.
+    int count = 0;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (int j = 0; j < k; ++j) {
       const int32_t b = nn[a * k + j];
       if (b < 0) continue;
-      nbr.push_back(points[alive[b]].x);
+      mean += points[alive[b]].x;
+      ++count;
     }
-    if (static_cast<int>(nbr.size()) < options.min_neighbours) continue;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto& q : nbr) mean += q;
-    mean /= static_cast<double>(nbr.size());
+    if (count < options.min_neighbours) continue;
+    mean /= static_cast<double>(count);
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const auto& q : nbr) cov += (q - mean) * (q - mean).transpose();
+    for (int j = 0; j < k; ++j) {
+      const int32_t b = nn[a * k + j];
+      if (b < 0) continue;
+      const Eigen::Vector3d d = points[alive[b]].x - mean;
+      cov += d * d.transpose();
+    }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
     const Eigen::Vector3d normal = es.eigenvectors().col(0);
     pass[a] = std::abs(normal.dot(p.x - mean)) <= tolerance * fp;

@@ -41,8 +41,9 @@ SpacingSum SumPointSpacing(const PointCloud& cloud, size_t stride) {
   std::vector<double> d2(2 * m);
   flann::Matrix<size_t> idx_m(idx.data(), m, 2);
   flann::Matrix<double> d2_m(d2.data(), m, 2);
-  index.knnSearch(flann::Matrix<double>(queries.data(), m, 3), idx_m, d2_m, 2,
-                  flann::SearchParams(flann::FLANN_CHECKS_UNLIMITED));
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
+  params.cores = 0;  // all of them: each query is independent
+  index.knnSearch(flann::Matrix<double>(queries.data(), m, 3), idx_m, d2_m, 2, params);
   for (size_t q = 0; q < m; ++q) sum.sum += std::sqrt(d2[2 * q + 1]);  // [0] is the point itself
   sum.samples = static_cast<long>(m);
   return sum;
