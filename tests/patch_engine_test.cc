@@ -17,6 +17,7 @@
 #include "match/group_data.h"
 #include "plane_scene.h"
 #include "sapmvs/match/match_group.h"
+#include "sapmvs/util/kernel_limits.h"
 
 namespace sapmvs {
 namespace {
@@ -254,6 +255,28 @@ TEST_F(PatchEngineTest, ViewOnlyImagesOnlyFillUpToMinImageNum) {
   }
   PatchEngine without(NewKernels(), own, options);
   for (const auto& r : without.Evaluate(seeds)) EXPECT_FALSE(r);
+}
+
+// A reference keeps its group's own images before another strip's
+// view-only ones when more than kMaxViews - 1 images overlap it: view-only
+// images only fill (PatchEngine::VisibleViews). Ten images 1 m apart at 40 m
+// all overlap image 0 well beyond SelectViews' 10 %; by overlap alone its
+// nearest neighbours, 1 and 2, would be kept and two of its own dropped.
+TEST(SelectViewsTest, OwnImagesComeBeforeViewOnlyOnes) {
+  const PlaneScene strip = MakePlaneScene(10, 201, 161, 99, 1.0);
+  for (const int view_only : {2, 3}) {
+    MatchGroupData group = GroupOf(strip);
+    for (MatchImage& im : group.images) im.depth = 40.0;
+    for (int i = 1; i <= view_only; ++i) group.images[i].reference = false;
+    SelectViews(MatcherOptions(), &group);
+    const std::vector<int>& views = group.images[0].views;
+    ASSERT_EQ(views.size(), static_cast<size_t>(kMaxViews - 1));
+    int own = 0;
+    for (const int v : views) own += group.images[v].reference;
+    // 7 own images with 2 view-only; with 3, the 6 own and then one of the others.
+    EXPECT_EQ(own, view_only == 2 ? 7 : 6) << view_only << " view-only";
+    EXPECT_TRUE(group.images[views.back()].reference == (view_only == 2)) << view_only;
+  }
 }
 
 // The paper's narrow baselines: 5 images 4 degrees apart along a strip

@@ -117,7 +117,13 @@ void SelectViews(const MatcherOptions& /*options*/, MatchGroupData* group) {
       const double overlap = static_cast<double>(inside) / (kGrid * kGrid);
       if (overlap >= 0.1) ranked.emplace_back(overlap, static_cast<int>(j));
     }
-    std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+    // The group's own images first, then another strip's view-only ones:
+    // those only fill (PatchEngine::VisibleViews), so with more than
+    // kMaxViews - 1 candidates (--max-images 7 or more with --strip-views)
+    // one must not push an own image out. Each part by overlap.
+    std::sort(ranked.begin(), ranked.end(), [&](const auto& a, const auto& b) {
+      const bool own_a = images[a.second].reference, own_b = images[b.second].reference;
+      if (own_a != own_b) return own_a;
       return a.first != b.first ? a.first > b.first : a.second < b.second;
     });
     im.views.clear();
