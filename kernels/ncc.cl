@@ -228,8 +228,8 @@ bool sample_view(__global const float* images, __global const int4* table, int i
              y <= y_max;
   }
   const int hs = PATCH_SIZE / 2;
-  // The vector path indexes an image with int offsets.
-  inside = inside && (long)t.z * (long)t.w <= (long)INT_MAX;
+  // The vector path indexes an image with int offsets: the host packs a
+  // group's images in at most INT_MAX elements (UploadNccGroup).
   if (!inside) {
     for (int r = 0; r < PATCH_SIZE; ++r) {
       for (int col = 0; col < PATCH_SIZE; ++col) {

@@ -80,8 +80,6 @@ EngineKernels EngineKernelVariants(const MatcherOptions& options) {
   return k;
 }
 
-double PatchEngine::SigmaColor() const { return SigmaColorOf(options_); }
-
 PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
                          const MatcherOptions& options)
     : kernels_(kernels),

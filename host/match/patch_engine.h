@@ -111,8 +111,6 @@ class PatchEngine {
   std::vector<int> WorthPolishing(int size, const std::vector<int>& open,
                                   const std::vector<std::optional<AcceptedPatch>>& results,
                                   std::vector<std::vector<int>>* views, std::vector<int>* rejected);
-  // The NCC sample weights (MatcherOptions::ncc_sigma_color; 0 in pmvs mode).
-  double SigmaColor() const;
   bool OnParentPlane(const PatchCandidate& candidate, const Eigen::Vector3d& center) const;
   // True when some pair of the reference and `views` meets at x at an angle
   // in (max_angle_deg, view_angle_deg); with from_ref, some pair of the
