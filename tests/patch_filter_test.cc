@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -225,6 +226,40 @@ TEST(FilterPoints, ThePlaneToleranceFollowsTheNoiseBetweenPatches) {
   EXPECT_GT(kept_share(b), 0.9);
   EXPECT_FALSE(a[outlier]);
   EXPECT_FALSE(b[outlier]);
+}
+
+// Flat blocks of points over 5 m apart (15 footprints, beyond the
+// neighbour radius), each a cluster of its own: one on either side of
+// min_cluster_size (30), and a large one. The points are shuffled, so that a
+// cluster's points lie in both halves of the point order that the threads of
+// the cluster search share.
+TEST(FilterPoints, ClustersBelowTheMinimumSizeGoWhicheverThreadSawThem) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  MatcherOptions options;
+  ASSERT_EQ(options.min_cluster_size, 30);
+  const int blocks[][2] = {{6, 4}, {5, 6}, {4, 7}, {7, 5}, {20, 20}};
+  std::vector<std::pair<Eigen::Vector3d, int>> all;  // point, its block's size
+  for (size_t b = 0; b < std::size(blocks); ++b) {
+    const int cols = blocks[b][0], rows = blocks[b][1];
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        all.push_back({Eigen::Vector3d(-30 + 12.0 * b + 0.3 * c, 0.3 * r, 0), cols * rows});
+      }
+    }
+  }
+  std::shuffle(all.begin(), all.end(), std::mt19937(5));
+  Points p;
+  for (const auto& [x, size] : all) p.Add(x, 0, {1, 2}, 0.95f);
+  MatchStats stats;
+  const std::vector<bool> keep = FilterPoints(group, options, p.points, p.patches, &stats, 0.0);
+  long small = 0;
+  for (size_t i = 0; i < all.size(); ++i) {
+    const int size = all[i].second;
+    EXPECT_EQ(keep[i], size >= 30) << "point " << i << " of a block of " << size;
+    small += size < 30;
+  }
+  EXPECT_EQ(stats.removed_clusters, small);
+  EXPECT_EQ(small, 24 + 28);
 }
 
 TEST(SeedDepthFences, TukeyFencesPaddedByTenGsdAndNoneBelowTenSeeds) {

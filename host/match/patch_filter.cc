@@ -3,9 +3,11 @@
 #include <flann/flann.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <parallel/algorithm>
 
 #include <Eigen/Eigenvalues>
 
@@ -20,12 +22,36 @@ namespace {
 // (pmvs) about 4.5.
 constexpr int kNeighbours = 16;
 
-int Find(std::vector<int>& parent, int i) {
-  while (parent[i] != i) {
-    parent[i] = parent[parent[i]];
-    i = parent[i];
+// A union-find that threads share. A root is only ever linked under a root
+// of smaller index, so every parent has a smaller index than its child: no
+// cycles, whatever the order of the links. The sets, which are all the
+// cluster test reads, do not depend on that order.
+using Parents = std::vector<std::atomic<int>>;
+
+// The root of i's set, halving the path on the way (a parent only moves to an
+// ancestor, so another thread's link never takes it out of its set).
+int Find(Parents& parent, int i) {
+  while (true) {
+    const int p = parent[i].load(std::memory_order_relaxed);
+    if (p == i) return i;
+    const int gp = parent[p].load(std::memory_order_relaxed);
+    if (gp != p) {
+      int expected = p;
+      parent[i].compare_exchange_weak(expected, gp, std::memory_order_relaxed);
+    }
+    i = gp;
   }
-  return i;
+}
+
+void Union(Parents& parent, int a, int b) {
+  while (true) {
+    a = Find(parent, a);
+    b = Find(parent, b);
+    if (a == b) return;
+    if (a < b) std::swap(a, b);
+    int expected = a;
+    if (parent[a].compare_exchange_strong(expected, b, std::memory_order_relaxed)) return;
+  }
 }
 
 }  // namespace
@@ -109,7 +135,9 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
       (d <= b.min_depth[cell] + tol ? b.front[cell] : b.back[cell]) += weight(i);
     });
   }
-  std::vector<bool> keep(points.size(), false);
+  // Bytes, not vector<bool>: its elements share words, and two threads
+  // writing neighbouring elements could lose one of the writes.
+  std::vector<uint8_t> kept(points.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t i = 0; i < points.size(); ++i) {
     if (!in(i)) continue;
@@ -139,9 +167,9 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
         if (d < buffers[v].min_depth[cell] - tol) violated += buffers[v].front[cell];
       }
     }
-    keep[i] = visible >= options.min_image_num && !occluding && violated <= weight(i);
+    kept[i] = visible >= options.min_image_num && !occluding && violated <= weight(i);
   }
-  return keep;
+  return std::vector<bool>(kept.begin(), kept.end());
 }
 
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
@@ -205,6 +233,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       flann::Matrix<size_t> nn_m(chunk_nn.data(), rows, k);
       flann::Matrix<float> nd_m(chunk_nd.data(), rows, k);
       index.knnSearch(queries, nn_m, nd_m, k, params);
+#pragma omp parallel for schedule(static)
       for (size_t r = 0; r < rows; ++r) {
         const size_t a = first + r;
         const float r2 = static_cast<float>(radius[a] * radius[a]);
@@ -249,7 +278,8 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     }
     if (!d.empty()) {
       auto mid = d.begin() + d.size() / 2;
-      std::nth_element(d.begin(), mid, d.end());
+      // The element at mid is the same whichever way it is found.
+      __gnu_parallel::nth_element(d.begin(), mid, d.end());
       tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * *mid);
     }
   }
@@ -289,14 +319,21 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // neighbours are the independent evidence. A majority is asked for, not
   // all, so a roof patch survives ground neighbours along its edge.
   std::vector<int> foreign(patches.size(), 0), consistent(patches.size(), 0);
+#pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const int id = points[alive[a]].patch;
+    int f = 0, c = 0;
     for (int j = 0; j < k; ++j) {
       const float d = foreign_distance[a * k + j];
       if (std::isnan(d)) continue;
-      ++foreign[id];
-      if (d <= tolerance) ++consistent[id];
+      ++f;
+      c += d <= tolerance;
     }
+    if (f == 0) continue;
+#pragma omp atomic
+    foreign[id] += f;
+#pragma omp atomic
+    consistent[id] += c;
   }
   auto supported = [&](int id) {
     return foreign[id] >= options.min_neighbours && 2 * consistent[id] >= foreign[id];
@@ -312,24 +349,30 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   stats->removed_neighbourhood = removed_plane;
 
   // 3. Small clusters among the survivors.
-  std::vector<int> parent(alive.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  for (size_t a = 0; a < alive.size(); ++a) {
+  const long n_alive = static_cast<long>(alive.size());
+  Parents parent(alive.size());
+  for (long a = 0; a < n_alive; ++a)
+    parent[a].store(static_cast<int>(a), std::memory_order_relaxed);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n_alive; ++a) {
     if (!pass[a]) continue;
     for (int j = 0; j < k; ++j) {
       const int32_t b = nn[a * k + j];
-      if (b < 0 || !pass[b]) continue;
-      const int ra = Find(parent, static_cast<int>(a)), rb = Find(parent, static_cast<int>(b));
-      if (ra != rb) parent[ra] = rb;
+      if (b >= 0 && pass[b]) Union(parent, static_cast<int>(a), b);
     }
   }
+  std::vector<int> root(alive.size(), -1);
+#pragma omp parallel for schedule(static)
+  for (long a = 0; a < n_alive; ++a) {
+    if (pass[a]) root[a] = Find(parent, static_cast<int>(a));
+  }
   std::vector<int> size(alive.size(), 0);
-  for (size_t a = 0; a < alive.size(); ++a) {
-    if (pass[a]) ++size[Find(parent, static_cast<int>(a))];
+  for (long a = 0; a < n_alive; ++a) {
+    if (pass[a]) ++size[root[a]];
   }
   long removed_clusters = 0;
-  for (size_t a = 0; a < alive.size(); ++a) {
-    if (pass[a] && size[Find(parent, static_cast<int>(a))] < options.min_cluster_size) {
+  for (long a = 0; a < n_alive; ++a) {
+    if (pass[a] && size[root[a]] < options.min_cluster_size) {
       keep[alive[a]] = false;
       ++removed_clusters;
     }
@@ -372,17 +415,24 @@ long ApplyDepthFences(const MatchGroupData& group, const std::vector<DensePoint>
                       const std::vector<AcceptedPatch>& patches,
                       const std::vector<std::pair<double, double>>& fences,
                       std::vector<bool>* keep) {
-  long removed = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
+  // vector<bool> packs its elements into shared words, so the threads only
+  // decide; the writes stay on one.
+  const long n = static_cast<long>(points.size());
+  std::vector<uint8_t> out(points.size(), 0);
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < n; ++i) {
     if (!(*keep)[i]) continue;
     const int ref = patches[points[i].patch].ref;
     const auto [lo, hi] = fences[ref];
     if (lo == 0 && hi == 0) continue;
     const double depth = group.images[ref].camera.Depth(points[i].x);
-    if (depth < lo || depth > hi) {
-      (*keep)[i] = false;
-      ++removed;
-    }
+    out[i] = depth < lo || depth > hi;
+  }
+  long removed = 0;
+  for (long i = 0; i < n; ++i) {
+    if (!out[i]) continue;
+    (*keep)[i] = false;
+    ++removed;
   }
   return removed;
 }

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "match/footprint.h"
+#include "sapmvs/util/parallel_for.h"
 
 namespace sapmvs {
 namespace {
@@ -45,37 +46,40 @@ std::vector<Eigen::Vector3d> FitPatchNormals(const MatchGroupData& group,
   index.knnSearch(data, nn_m, nd_m, k, params);
 
   const double cos_max = std::cos(options.view_angle_deg * M_PI / 180.0);
-#pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < ids.size(); ++a) {
-    const AcceptedPatch& pa = patches[ids[a]];
-    const Camera& cam = group.images[pa.ref].camera;
-    const double fp = Footprint(cam, pa.center);
-    // Along the plane's slope: a window's reach on a surface seen obliquely.
-    const double reach = (pa.size + 4) * SlopeFootprint(cam, pa.center, pa.normal);
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    int support = 0;
-    for (int j = 0; j < k; ++j) {
-      const size_t b = nn[a * k + j];
-      if (b == a) continue;
-      const Eigen::Vector3d d = patches[ids[b]].center - pa.center;
-      const double dist = d.norm();
-      // A centre within half a footprint says nothing about the slope.
-      if (dist > reach || dist < 0.5 * fp) continue;
-      if (std::abs(pa.normal.dot(d)) > options.refit_tolerance * fp) continue;
-      scatter += d * d.transpose() / (dist * dist);
-      ++support;
-    }
-    if (support < kMinSupport) continue;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(scatter);
-    // Collinear centres (a ridge, a row along an edge) leave the plane free
-    // to turn about their line.
-    if (es.eigenvalues()[1] < 0.1 * es.eigenvalues()[2]) continue;
-    Eigen::Vector3d n = es.eigenvectors().col(0);
-    const Eigen::Vector3d to_ref = (cam.center() - pa.center).normalized();
-    if (n.dot(to_ref) < 0) n = -n;
-    if (n.dot(to_ref) < cos_max) continue;
-    fitted[ids[a]] = n;
-  }
+  // Between device launches: ParallelFor's threads do not spin afterwards.
+  ParallelFor(
+      static_cast<long>(ids.size()),
+      [&](long a) {
+        const AcceptedPatch& pa = patches[ids[a]];
+        const Camera& cam = group.images[pa.ref].camera;
+        const double fp = Footprint(cam, pa.center);
+        // Along the plane's slope: a window's reach on a surface seen obliquely.
+        const double reach = (pa.size + 4) * SlopeFootprint(cam, pa.center, pa.normal);
+        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+        int support = 0;
+        for (int j = 0; j < k; ++j) {
+          const size_t b = nn[a * k + j];
+          if (b == static_cast<size_t>(a)) continue;
+          const Eigen::Vector3d d = patches[ids[b]].center - pa.center;
+          const double dist = d.norm();
+          // A centre within half a footprint says nothing about the slope.
+          if (dist > reach || dist < 0.5 * fp) continue;
+          if (std::abs(pa.normal.dot(d)) > options.refit_tolerance * fp) continue;
+          scatter += d * d.transpose() / (dist * dist);
+          ++support;
+        }
+        if (support < kMinSupport) return;
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(scatter);
+        // Collinear centres (a ridge, a row along an edge) leave the plane free
+        // to turn about their line.
+        if (es.eigenvalues()[1] < 0.1 * es.eigenvalues()[2]) return;
+        Eigen::Vector3d n = es.eigenvectors().col(0);
+        const Eigen::Vector3d to_ref = (cam.center() - pa.center).normalized();
+        if (n.dot(to_ref) < 0) n = -n;
+        if (n.dot(to_ref) < cos_max) return;
+        fitted[ids[a]] = n;
+      },
+      64);
   return fitted;
 }
 

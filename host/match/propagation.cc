@@ -3,6 +3,7 @@
 #include "match/footprint.h"
 #include "match/ncc_score_reference.h"
 #include "match/plane_refit.h"
+#include "sapmvs/util/parallel_for.h"
 
 #include <algorithm>
 #include <cmath>
@@ -108,48 +109,54 @@ bool Propagator::IsBarrier(int image, int x, int y, const AcceptedPatch& patch) 
   return off_plane > options_.depth_tolerance * footprint;
 }
 
-bool Propagator::Emit(const AcceptedPatch& patch) {
-  const int id = static_cast<int>(patches_.size());
+Propagator::EmitPlan Propagator::PlanEmit(const AcceptedPatch& patch) const {
+  EmitPlan plan;
   const Camera& cam = group_.images[patch.ref].camera;
-  Grid& grid = grids_[patch.ref];
+  const Grid& grid = grids_[patch.ref];
   const int cs = options_.cell_size;
   const Eigen::Vector2d uv0 = cam.Project(patch.center);
-  const size_t first_point = points_.size();
-  auto emit_at = [&](int x, int y, const Eigen::Vector3d& p) {
-    const int cell = grid.Index(Eigen::Vector2d(x, y), cs);
-    if (cell < 0 || (grid.owner[cell] != -1 && grid.owner[cell] != id)) return;
-    if (!p.allFinite()) return;
-    grid.owner[cell] = id;
-    DensePoint d;
-    d.x = p;
-    d.patch = id;
-    d.uv = Eigen::Vector2f(static_cast<float>(x), static_cast<float>(y));
-    points_.push_back(d);
-  };
-  const int cx = static_cast<int>(std::lround(uv0.x()));
-  const int cy = static_cast<int>(std::lround(uv0.y()));
   if (options_.mode == MatchMode::kPmvs || patch.size <= 1) {
-    const int cell = grid.Index(uv0, cs);
-    if (cell >= 0 && grid.owner[cell] == -1) {
-      grid.owner[cell] = id;
-      DensePoint d;
-      d.x = patch.center;
-      d.patch = id;
-      d.uv = uv0.cast<float>();
-      points_.push_back(d);
-    }
+    DensePoint d;
+    d.x = patch.center;
+    d.uv = uv0.cast<float>();
+    plan.points.push_back(d);
+    plan.ref_cells.push_back(grid.Index(uv0, cs));
   } else {
+    const int cx = static_cast<int>(std::lround(uv0.x()));
+    const int cy = static_cast<int>(std::lround(uv0.y()));
     const auto pixels = WindowPixels(
         group_.images[patch.ref].grey, cx, cy, patch.size, options_.ncc_sigma_color,
         options_.emit_min_weight, [&](int x, int y) { return IsBarrier(patch.ref, x, y, patch); });
     for (const auto& [x, y] : pixels) {
-      emit_at(x, y, IntersectPlane(cam, Eigen::Vector2d(x, y), patch.center, patch.normal));
+      const Eigen::Vector3d p =
+          IntersectPlane(cam, Eigen::Vector2d(x, y), patch.center, patch.normal);
+      if (!p.allFinite()) continue;
+      DensePoint d;
+      d.x = p;
+      d.uv = Eigen::Vector2f(static_cast<float>(x), static_cast<float>(y));
+      plan.points.push_back(d);
+      plan.ref_cells.push_back(grid.Index(Eigen::Vector2d(x, y), cs));
     }
+  }
+  return plan;
+}
+
+bool Propagator::Emit(const AcceptedPatch& patch, const EmitPlan& plan) {
+  const int id = static_cast<int>(patches_.size());
+  Grid& grid = grids_[patch.ref];
+  const size_t first_point = points_.size();
+  for (size_t k = 0; k < plan.points.size(); ++k) {
+    const int cell = plan.ref_cells[k];
+    if (cell < 0 || (grid.owner[cell] != -1 && grid.owner[cell] != id)) continue;
+    grid.owner[cell] = id;
+    points_.push_back(plan.points[k]);
+    points_.back().patch = id;
   }
   if (points_.size() == first_point) return false;
   emitted_ += static_cast<long>(points_.size() - first_point);
   // The views' cells where the points land are covered too, so the same
   // ground is not matched again with another reference.
+  const int cs = options_.cell_size;
   for (const int v : patch.views) {
     const Camera& vc = group_.images[v].camera;
     Grid& vg = grids_[v];
@@ -220,9 +227,20 @@ std::vector<int> Propagator::AcceptBatch(std::vector<std::optional<AcceptedPatch
   // Better patches claim contested cells first.
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return results[a]->score > results[b]->score; });
+  // The points and cells a patch would claim depend only on the patch, so
+  // they are computed on all cores; the claims, which depend on the order,
+  // stay in order. In chunks, so that a wave of large patches does not hold
+  // all its plans at once.
+  constexpr size_t kChunk = 256;
   std::vector<int> accepted;
-  for (const int i : order) {
-    if (Emit(*results[i])) accepted.push_back(i);
+  std::vector<EmitPlan> plans(std::min(order.size(), kChunk));
+  for (size_t b = 0; b < order.size(); b += kChunk) {
+    const int n = static_cast<int>(std::min(order.size() - b, kChunk));
+    ParallelFor(
+        n, [&](long j) { plans[j] = PlanEmit(*results[order[b + j]]); }, 4);
+    for (int j = 0; j < n; ++j) {
+      if (Emit(*results[order[b + j]], plans[j])) accepted.push_back(order[b + j]);
+    }
   }
   return accepted;
 }
@@ -288,29 +306,44 @@ long Propagator::RefitPlanes() {
     if (!fitted[p].isZero()) patches_[p].normal = fitted[p];
     centre_uv[p] = group_.images[patches_[p].ref].camera.Project(patches_[p].center);
   }
+  // Each point's fate and new position depend on its patch only, so they
+  // are decided on all cores; a point that is dropped keeps its old
+  // position, from which Release finds the cells it owns.
+  enum Fate : uint8_t { kKeep, kCut, kNoPoint };
+  std::vector<uint8_t> fate(points_.size(), kKeep);
+  const long n = static_cast<long>(points_.size());
+  ParallelFor(
+      n,
+      [&](long i) {
+        DensePoint& d = points_[i];
+        const AcceptedPatch& patch = patches_[d.patch];
+        if (fitted[d.patch].isZero()) {
+          const Eigen::Vector2d off = d.uv.cast<double>() - centre_uv[d.patch];
+          // Pixel uv lies within kUnfittedReach of the rounded centre.
+          if (off.cwiseAbs().maxCoeff() > kUnfittedReach + 0.5) fate[i] = kCut;
+        } else {
+          const Eigen::Vector3d x = IntersectPlane(group_.images[patch.ref].camera,
+                                                   d.uv.cast<double>(), patch.center, patch.normal);
+          if (x.allFinite()) {
+            d.x = x;
+          } else {
+            fate[i] = kNoPoint;
+          }
+        }
+      },
+      1024);
   const size_t before = points_.size();
   size_t out = 0;
   std::vector<int> newly_cut;
   for (size_t i = 0; i < points_.size(); ++i) {
-    DensePoint d = points_[i];
-    const AcceptedPatch& patch = patches_[d.patch];
-    if (fitted[d.patch].isZero()) {
-      const Eigen::Vector2d off = d.uv.cast<double>() - centre_uv[d.patch];
-      // Pixel uv lies within kUnfittedReach of the rounded centre.
-      if (off.cwiseAbs().maxCoeff() > kUnfittedReach + 0.5) {
-        if (!cut_[d.patch]) newly_cut.push_back(d.patch);
-        cut_[d.patch] = 1;
-        Release(d);
-        continue;
-      }
-    } else {
-      const Eigen::Vector3d x = IntersectPlane(group_.images[patch.ref].camera, d.uv.cast<double>(),
-                                               patch.center, patch.normal);
-      if (!x.allFinite()) {
-        Release(d);
-        continue;
-      }
-      d.x = x;
+    const DensePoint d = points_[i];
+    if (fate[i] == kCut) {
+      if (!cut_[d.patch]) newly_cut.push_back(d.patch);
+      cut_[d.patch] = 1;
+    }
+    if (fate[i] != kKeep) {
+      Release(d);
+      continue;
     }
     points_[out++] = d;
   }
@@ -345,12 +378,38 @@ void Propagator::Prune(const std::vector<bool>& keep) {
     const int cell = grid.Index(d.uv.cast<double>(), cs);
     if (cell >= 0) grid.owner[cell] = d.patch;
   }
-  for (const DensePoint& d : points_) {
-    for (const int v : patches_[d.patch].views) {
-      const Camera& vc = group_.images[v].camera;
-      if (!(vc.Depth(d.x) > 0)) continue;
-      const int cell = grids_[v].Index(vc.Project(d.x), cs);
-      if (cell >= 0 && grids_[v].owner[cell] == -1) grids_[v].owner[cell] = d.patch;
+  // The view cells are projected on all cores and claimed in point order (the
+  // first claim holds), a chunk of points at a time.
+  constexpr size_t kChunk = 65536;
+  std::vector<size_t> offset;
+  std::vector<int> view_cells;
+  for (size_t first = 0; first < points_.size(); first += kChunk) {
+    const size_t n = std::min(kChunk, points_.size() - first);
+    offset.assign(n + 1, 0);
+    for (size_t i = 0; i < n; ++i) {
+      offset[i + 1] = offset[i] + patches_[points_[first + i].patch].views.size();
+    }
+    view_cells.assign(offset[n], -1);
+    ParallelFor(
+        static_cast<long>(n),
+        [&](long i) {
+          const DensePoint& d = points_[first + i];
+          const std::vector<int>& views = patches_[d.patch].views;
+          for (size_t j = 0; j < views.size(); ++j) {
+            const Camera& vc = group_.images[views[j]].camera;
+            if (vc.Depth(d.x) > 0) {
+              view_cells[offset[i] + j] = grids_[views[j]].Index(vc.Project(d.x), cs);
+            }
+          }
+        },
+        256);
+    for (size_t i = 0; i < n; ++i) {
+      const DensePoint& d = points_[first + i];
+      const std::vector<int>& views = patches_[d.patch].views;
+      for (size_t j = 0; j < views.size(); ++j) {
+        const int cell = view_cells[offset[i] + j];
+        if (cell >= 0 && grids_[views[j]].owner[cell] == -1) grids_[views[j]].owner[cell] = d.patch;
+      }
     }
   }
   for (size_t g = 0; g < grids_.size(); ++g) {

@@ -89,9 +89,16 @@ class Propagator {
     std::vector<uint8_t> tries;                            // candidates started in the cell
     int Index(const Eigen::Vector2d& uv, int cell) const;  // -1 outside
   };
-  // Emits the points of `patch`; returns false (and stores nothing) when no
-  // cell was left for it.
-  bool Emit(const AcceptedPatch& patch);
+  // What a patch would emit: its points (local frame, reference pixel) and
+  // the reference cell of each (-1 outside).
+  struct EmitPlan {
+    std::vector<DensePoint> points;
+    std::vector<int> ref_cells;
+  };
+  EmitPlan PlanEmit(const AcceptedPatch& patch) const;
+  // Emits the planned points of `patch` whose reference cells are still
+  // free; returns false (and stores nothing) when no cell was left for it.
+  bool Emit(const AcceptedPatch& patch, const EmitPlan& plan);
   void Expand(int patch_index, std::vector<PatchCandidate>* front);
   // Frees the cells point d owns, in its reference and its patch's views.
   void Release(const DensePoint& d);

@@ -1,0 +1,55 @@
+#include "sapmvs/util/parallel_for.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "sapmvs/util/thread_count.h"
+
+namespace sapmvs {
+namespace {
+
+TEST(ParallelFor, CallsEveryIndexOnceWhateverTheBlock) {
+  for (const long n : {0L, 1L, 15L, 16L, 17L, 1000L, 100003L}) {
+    for (const long block : {1L, 16L, 1000L}) {
+      std::vector<std::atomic<int>> calls(n);
+      for (auto& c : calls) c.store(0);
+      ParallelFor(
+          n, [&](long i) { calls[i].fetch_add(1); }, block);
+      for (long i = 0; i < n; ++i) {
+        ASSERT_EQ(calls[i].load(), 1) << "n " << n << " block " << block << " index " << i;
+      }
+    }
+  }
+}
+
+TEST(ParallelFor, SharesTheWorkAndLeavesNoThreadBehind) {
+  if (HostThreadCount() < 2) GTEST_SKIP() << "one host thread: nothing to share";
+  std::mutex m;
+  std::set<std::thread::id> ids;
+  // Each call waits until a second thread has joined in (or gives up), so the
+  // test does not depend on how quickly the extra thread starts.
+  std::atomic<int> busy{0};
+  ParallelFor(
+      64,
+      [&](long) {
+        {
+          std::lock_guard<std::mutex> lock(m);
+          ids.insert(std::this_thread::get_id());
+        }
+        busy.fetch_add(1);
+        for (int spin = 0; spin < 20000 && ids.size() < 2; ++spin) std::this_thread::yield();
+      },
+      1);
+  EXPECT_EQ(busy.load(), 64);
+  EXPECT_GE(ids.size(), 2u);
+  EXPECT_LE(ids.size(), static_cast<size_t>(HostThreadCount()));
+  EXPECT_TRUE(ids.count(std::this_thread::get_id())) << "the caller takes part";
+}
+
+}  // namespace
+}  // namespace sapmvs
