@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "plane_scene.h"
 #include "sapmvs/match/match_group.h"
 #include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/thread_count.h"
 
 namespace sapmvs {
 namespace {
@@ -193,6 +195,51 @@ TEST_F(PatchEngineTest, LaunchesOnlyTheVariantsPreparedForIt) {
     EXPECT_EQ(VariantsWithin(kernels.scorers, variants.scorers), sapmvs ? 2 : 1);
     EXPECT_EQ(VariantsWithin(kernels.refiners, variants.refiners), sapmvs ? 2 : 1);
   }
+}
+
+// A batch large enough to be evaluated as two halves on two threads gets,
+// candidate by candidate, the results its pieces get one small batch at a
+// time: the halves neither mix up nor reorder results, and accepted and
+// rejected candidates are spread over both halves.
+TEST_F(PatchEngineTest, ALargeBatchGetsTheResultsItsPiecesGetAlone) {
+  const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
+  const MatchGroupData group = GroupOf(scene);
+  MatcherOptions options;
+  options.max_angle_deg = 5.0;  // as above, so that patches grow
+  const std::vector<PatchCandidate> good = TiltedSeeds(scene, 400, 1.0, 6.0, 101);
+  const std::vector<PatchCandidate> away = TiltedSeeds(scene, 400, 0.0, 80.0, 102);
+  std::vector<PatchCandidate> batch;
+  for (size_t i = 0; i < good.size(); ++i) {
+    batch.push_back(good[i]);
+    if (i % 3 == 0) batch.push_back(away[i]);
+  }
+  PatchEngine whole(NewKernels(), group, options);
+  const auto results = whole.Evaluate(batch);
+  PatchEngine pieces(NewKernels(), group, options);
+  std::vector<std::optional<AcceptedPatch>> expected;
+  for (size_t b = 0; b < batch.size(); b += 100) {
+    const std::vector<PatchCandidate> piece(batch.begin() + b,
+                                            batch.begin() + std::min(batch.size(), b + 100));
+    for (auto& r : pieces.Evaluate(piece)) expected.push_back(std::move(r));
+  }
+  ASSERT_EQ(results.size(), batch.size());
+  ASSERT_EQ(expected.size(), batch.size());
+  int accepted = 0;
+  for (size_t i = 0; i < batch.size(); ++i) {
+    ASSERT_EQ(results[i].has_value(), expected[i].has_value()) << "candidate " << i;
+    if (!results[i]) continue;
+    ++accepted;
+    EXPECT_EQ(results[i]->center, expected[i]->center) << "candidate " << i;
+    EXPECT_EQ(results[i]->normal, expected[i]->normal) << "candidate " << i;
+    EXPECT_EQ(results[i]->score, expected[i]->score) << "candidate " << i;
+    EXPECT_EQ(results[i]->size, expected[i]->size) << "candidate " << i;
+    EXPECT_EQ(results[i]->views, expected[i]->views) << "candidate " << i;
+  }
+  EXPECT_GT(accepted, 300);
+  EXPECT_LT(accepted, static_cast<int>(batch.size()) - 100);
+  // Two halves, one 7 x 7 refinement each, where there are two host threads.
+  const int halves = HostThreadCount() >= 2 ? 2 : 1;
+  EXPECT_EQ(whole.kernel_times().at("patch_refine 7x7").launches, halves);
 }
 
 // Seeds on the ground are rejected when fewer than min_image_num - 1 other

@@ -2,10 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <iterator>
+#include <thread>
 
 #include "match/footprint.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/thread_count.h"
 
 namespace sapmvs {
 namespace {
@@ -55,6 +59,7 @@ std::map<int, PatchRefinerOptions> PolishOptionsOf(const MatcherOptions& options
     po.depth_step = kPolishDepthStep;
     po.angle_step_deg = kPolishAngleStepDeg;
     po.sigma_color = SigmaColorOf(options);
+    po.work_group_size = kPolishWorkGroupSize;
     polish[size] = po;
   }
   return polish;
@@ -97,6 +102,7 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
                                                   const std::vector<std::vector<int>>& views) {
   if (patches.empty()) return {};
   double seconds = 0;
+  std::lock_guard<std::mutex> lock(launch_mutex_);
   std::vector<RefinedPatch> out = kernels_.Refine(ro, patches, views, &seconds);
   // Labelled by the window's side in pixels.
   const int size = static_cast<int>(std::lround((ro.patch_size - 1) * ro.sample_step)) + 1;
@@ -127,6 +133,7 @@ std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& p
   if (pairs.empty()) return {};
   const NccScorerOptions so = ScoreOptionsOf(options_, size);
   double seconds = 0;
+  std::lock_guard<std::mutex> lock(launch_mutex_);
   std::vector<float> scores = kernels_.Score(so, patches, pairs, &seconds);
   Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size), size,
         static_cast<long>(pairs.size()), static_cast<double>(pairs.size()), seconds);
@@ -306,6 +313,36 @@ bool PatchEngine::WideEnough(const Eigen::Vector3d& x, int ref, const std::vecto
 }
 
 std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
+    const std::vector<PatchCandidate>& candidates) {
+  // Below this many candidates a half's kernels are too short to hide the
+  // other half's host steps behind.
+  constexpr size_t kMinHalf = 256;
+  if (candidates.size() < 2 * kMinHalf || HostThreadCount() < 2) return EvaluateBatch(candidates);
+  const auto mid = candidates.begin() + static_cast<long>(candidates.size() / 2);
+  const std::vector<PatchCandidate> first(candidates.begin(), mid), second(mid, candidates.end());
+  std::vector<std::optional<AcceptedPatch>> results, rest;
+  std::exception_ptr failed;
+  std::thread other([&] {
+    try {
+      rest = EvaluateBatch(second);
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  });
+  try {
+    results = EvaluateBatch(first);
+  } catch (...) {
+    other.join();
+    throw;
+  }
+  other.join();
+  if (failed) std::rethrow_exception(failed);
+  results.insert(results.end(), std::make_move_iterator(rest.begin()),
+                 std::make_move_iterator(rest.end()));
+  return results;
+}
+
+std::vector<std::optional<AcceptedPatch>> PatchEngine::EvaluateBatch(
     const std::vector<PatchCandidate>& candidates) {
   const int need = options_.min_image_num - 1;
   const int half = options_.window_size / 2;

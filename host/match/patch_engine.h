@@ -23,6 +23,7 @@
 // LiDAR from 54.5 % to 70.8 %).
 #include <Eigen/Core>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,7 +85,10 @@ class PatchEngine {
   PatchEngine(const PatchEngine&) = delete;
   PatchEngine& operator=(const PatchEngine&) = delete;
 
-  // One result per candidate, in order; nullopt = rejected.
+  // One result per candidate, in order; nullopt = rejected. A candidate's
+  // result does not depend on the others in the batch, so a large batch is
+  // evaluated as two halves on two threads: while one half's host steps run,
+  // the other half's kernels keep the device busy.
   std::vector<std::optional<AcceptedPatch>> Evaluate(const std::vector<PatchCandidate>& candidates);
 
   // NCC of patches (centre, normal, ref) against `view`, window_size grid:
@@ -119,6 +123,8 @@ class PatchEngine {
                   bool from_ref = false) const;
   std::vector<int> VisibleViews(const Eigen::Vector3d& center, const Eigen::Vector3d& normal,
                                 int ref, int half) const;
+  std::vector<std::optional<AcceptedPatch>> EvaluateBatch(
+      const std::vector<PatchCandidate>& candidates);
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,
                              const std::vector<NccPair>& pairs);
   void Count(const std::string& kernel, int patch_size, long items, double ncc_evaluations,
@@ -133,6 +139,9 @@ class PatchEngine {
   PatchRefinerOptions refine_options_;
   std::map<int, PatchRefinerOptions> polish_options_;  // by patch side (sapmvs)
   std::map<std::string, KernelTime> kernel_times_;
+  // Held for each launch and its count: PatchKernels takes one call at a
+  // time, and the halves of Evaluate launch from two threads.
+  std::mutex launch_mutex_;
 };
 
 }  // namespace sapmvs

@@ -136,70 +136,75 @@ std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
     index.emplace_back(features[i], group.images[i].camera.width(),
                        group.images[i].camera.height());
   }
-  std::vector<SeedFeature> seeds;
+  // Every reference feature of every image in one loop: one loop per image
+  // left a core idle at each image's tail.
+  std::vector<std::pair<int, int>> work;  // (image, feature), in seed order
   for (int i = 0; i < n; ++i) {
-    const MatchImage& ref = group.images[i];
-    if (!ref.reference) continue;  // its features are partners only
-    std::vector<SeedFeature> local(features[i].size());
+    if (!group.images[i].reference) continue;  // its features are partners only
+    for (size_t fi = 0; fi < features[i].size(); ++fi) work.emplace_back(i, static_cast<int>(fi));
+  }
+  std::vector<SeedFeature> local(work.size());
 #pragma omp parallel for schedule(dynamic, 64)
-    for (size_t fi = 0; fi < features[i].size(); ++fi) {
-      const Feature& f = features[i][fi];
-      std::vector<Scored> scored;
-      thread_local std::vector<int> near_segment;
-      thread_local FeatureIndex::Scratch scratch;
-      const Eigen::Vector3d near_point = ref.camera.BackProject(f.uv, kSeedDepthMin * ref.depth);
-      const Eigen::Vector3d far_point = ref.camera.BackProject(f.uv, kSeedDepthMax * ref.depth);
-      for (const int j : ref.views) {
-        const Camera& cam = group.images[j].camera;
-        if (!(cam.Depth(near_point) > 0) || !(cam.Depth(far_point) > 0)) continue;
-        const Eigen::Vector2d a = cam.Project(near_point), b = cam.Project(far_point);
-        const Eigen::Vector2d dir = b - a;
-        const double len2 = dir.squaredNorm();
-        if (!(len2 > 1e-12)) continue;
-        // Only the features near the segment, in index order as a scan of
-        // all of them met them (the sort below keeps ties in that order):
-        // the scan cost features x features per pair of images, 22 s of
-        // host time on Herz-Jesu-P8 at level 1.
-        index[j].Along(a, b, options.epipolar_distance, &scratch, &near_segment);
-        for (const int gi : near_segment) {
-          const Feature& g = features[j][gi];
-          if (g.kind != f.kind) continue;
-          const double t = (g.uv - a).dot(dir) / len2;
-          if (t < 0 || t > 1) continue;
-          const double dist = (g.uv - (a + t * dir)).norm();
-          if (dist > options.epipolar_distance) continue;
-          const Eigen::Vector3d x = TriangulateMidpoint(ref.camera, f.uv, cam, g.uv);
-          if (!x.allFinite()) continue;
-          const double depth = ref.camera.Depth(x);
-          if (depth < kSeedDepthMin * ref.depth || depth > kSeedDepthMax * ref.depth) continue;
-          Scored s;
-          s.candidate.center = x;
-          s.candidate.normal = (ref.camera.center() - x).normalized();
-          s.candidate.ref = i;
-          s.epipolar = dist;
-          for (const int k : ref.views) {
-            if (k == j) continue;
-            const Camera& ck = group.images[k].camera;
-            if (!(ck.Depth(x) > 0)) continue;
-            if (index[k].Near(ck.Project(x), f.kind, options.epipolar_distance)) ++s.support;
-          }
-          scored.push_back(s);
+  for (size_t w = 0; w < work.size(); ++w) {
+    const int i = work[w].first;
+    const MatchImage& ref = group.images[i];
+    const Feature& f = features[i][work[w].second];
+    std::vector<Scored> scored;
+    thread_local std::vector<int> near_segment;
+    thread_local FeatureIndex::Scratch scratch;
+    const Eigen::Vector3d near_point = ref.camera.BackProject(f.uv, kSeedDepthMin * ref.depth);
+    const Eigen::Vector3d far_point = ref.camera.BackProject(f.uv, kSeedDepthMax * ref.depth);
+    for (const int j : ref.views) {
+      const Camera& cam = group.images[j].camera;
+      if (!(cam.Depth(near_point) > 0) || !(cam.Depth(far_point) > 0)) continue;
+      const Eigen::Vector2d a = cam.Project(near_point), b = cam.Project(far_point);
+      const Eigen::Vector2d dir = b - a;
+      const double len2 = dir.squaredNorm();
+      if (!(len2 > 1e-12)) continue;
+      // Only the features near the segment, in index order as a scan of
+      // all of them met them (the sort below keeps ties in that order):
+      // the scan cost features x features per pair of images, 22 s of
+      // host time on Herz-Jesu-P8 at level 1.
+      index[j].Along(a, b, options.epipolar_distance, &scratch, &near_segment);
+      for (const int gi : near_segment) {
+        const Feature& g = features[j][gi];
+        if (g.kind != f.kind) continue;
+        const double t = (g.uv - a).dot(dir) / len2;
+        if (t < 0 || t > 1) continue;
+        const double dist = (g.uv - (a + t * dir)).norm();
+        if (dist > options.epipolar_distance) continue;
+        const Eigen::Vector3d x = TriangulateMidpoint(ref.camera, f.uv, cam, g.uv);
+        if (!x.allFinite()) continue;
+        const double depth = ref.camera.Depth(x);
+        if (depth < kSeedDepthMin * ref.depth || depth > kSeedDepthMax * ref.depth) continue;
+        Scored s;
+        s.candidate.center = x;
+        s.candidate.normal = (ref.camera.center() - x).normalized();
+        s.candidate.ref = i;
+        s.epipolar = dist;
+        for (const int k : ref.views) {
+          if (k == j) continue;
+          const Camera& ck = group.images[k].camera;
+          if (!(ck.Depth(x) > 0)) continue;
+          if (index[k].Near(ck.Project(x), f.kind, options.epipolar_distance)) ++s.support;
         }
-      }
-      std::sort(scored.begin(), scored.end(), [](const Scored& p, const Scored& q) {
-        return p.support != q.support ? p.support > q.support : p.epipolar < q.epipolar;
-      });
-      SeedFeature& out = local[fi];
-      out.image = i;
-      out.uv = f.uv;
-      for (const Scored& s : scored) {
-        if (static_cast<int>(out.candidates.size()) >= options.candidates_per_feature) break;
-        out.candidates.push_back(s.candidate);
+        scored.push_back(s);
       }
     }
-    for (SeedFeature& s : local) {
-      if (!s.candidates.empty()) seeds.push_back(std::move(s));
+    std::sort(scored.begin(), scored.end(), [](const Scored& p, const Scored& q) {
+      return p.support != q.support ? p.support > q.support : p.epipolar < q.epipolar;
+    });
+    SeedFeature& out = local[w];
+    out.image = i;
+    out.uv = f.uv;
+    for (const Scored& s : scored) {
+      if (static_cast<int>(out.candidates.size()) >= options.candidates_per_feature) break;
+      out.candidates.push_back(s.candidate);
     }
+  }
+  std::vector<SeedFeature> seeds;
+  for (SeedFeature& s : local) {
+    if (!s.candidates.empty()) seeds.push_back(std::move(s));
   }
   return seeds;
 }

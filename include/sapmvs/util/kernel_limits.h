@@ -12,6 +12,13 @@ namespace sapmvs {
 // below any device's CL_DEVICE_MAX_WORK_GROUP_SIZE.
 inline constexpr int kDefaultWorkGroupSize = 64;
 
+// Work-items per work-group of the polish refinements (the larger adaptive
+// sizes, patch_engine.cc). Their launches hold tens to hundreds of patches:
+// in groups of 64 that was one to three work-groups, so one of PoCL's
+// threads often refined them all while the other waited. On a GPU the
+// smaller groups only spread so few patches over more compute units.
+inline constexpr int kPolishWorkGroupSize = 8;
+
 // Largest side of a square matching window, in pixels (odd). Bounds the
 // per-work-item private arrays of the NCC kernels.
 inline constexpr int kMaxPatchSize = 21;
