@@ -5,6 +5,7 @@
 #include <atomic>
 #include <mutex>
 #include <set>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -49,6 +50,22 @@ TEST(ParallelFor, SharesTheWorkAndLeavesNoThreadBehind) {
   EXPECT_GE(ids.size(), 2u);
   EXPECT_LE(ids.size(), static_cast<size_t>(HostThreadCount()));
   EXPECT_TRUE(ids.count(std::this_thread::get_id())) << "the caller takes part";
+}
+
+TEST(ParallelFor, RethrowsTheFirstFailureAfterEveryThreadStopped) {
+  std::atomic<long> calls{0};
+  auto run = [&] {
+    ParallelFor(
+        100000,
+        [&](long i) {
+          calls.fetch_add(1);
+          if (i == 500) throw std::runtime_error("index 500");
+        },
+        10);
+  };
+  EXPECT_THROW(run(), std::runtime_error);
+  // The indices after the failure were skipped, not all run.
+  EXPECT_LT(calls.load(), 100000);
 }
 
 }  // namespace

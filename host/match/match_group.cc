@@ -20,6 +20,7 @@
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
 #include "sapmvs/util/memory_use.h"
+#include "sapmvs/util/parallel_for.h"
 #include "sapmvs/util/progress.h"
 #include "util/run_progress.h"
 
@@ -137,11 +138,15 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                           ? std::max(options.window_size, options.adaptive_sizes.front())
                           : options.window_size;
   const int margin = largest / 2 + 1;
+  // One image per thread: OpenCV's filters here hardly use a second core.
   std::vector<std::vector<Feature>> features(group.images.size());
-  for (size_t i = 0; i < group.images.size(); ++i) {
-    features[i] = DetectFeatures(group.images[i].grey, options.features_per_block, margin);
-    stats.features += static_cast<long>(features[i].size());
-  }
+  ParallelFor(
+      static_cast<long>(group.images.size()),
+      [&](long i) {
+        features[i] = DetectFeatures(group.images[i].grey, options.features_per_block, margin);
+      },
+      1);
+  for (const std::vector<Feature>& f : features) stats.features += static_cast<long>(f.size());
   end_stage("features");
 
   report("seeds", 0, 0, "epipolar candidates");

@@ -9,6 +9,8 @@
 // the loop nothing is left running.
 #include <algorithm>
 #include <atomic>
+#include <exception>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -17,8 +19,10 @@
 namespace sapmvs {
 
 // Calls f(i) once for every i in [0, n), on up to HostThreadCount() threads
-// (the caller's among them), `block` consecutive indices at a time. f must
-// not throw; calls for different i may run at once.
+// (the caller's among them), `block` consecutive indices at a time; calls
+// for different i may run at once. When a call throws, the indices not yet
+// started are skipped and the first exception is rethrown here, after every
+// thread has stopped.
 template <typename F>
 void ParallelFor(long n, const F& f, long block = 16) {
   const long threads = std::min<long>(HostThreadCount(), (n + block - 1) / block);
@@ -27,15 +31,24 @@ void ParallelFor(long n, const F& f, long block = 16) {
     return;
   }
   std::atomic<long> next{0};
+  std::mutex failed_mutex;
+  std::exception_ptr failed;
   auto work = [&] {
-    for (long b = next.fetch_add(block); b < n; b = next.fetch_add(block)) {
-      for (long i = b, e = std::min(n, b + block); i < e; ++i) f(i);
+    try {
+      for (long b = next.fetch_add(block); b < n; b = next.fetch_add(block)) {
+        for (long i = b, e = std::min(n, b + block); i < e; ++i) f(i);
+      }
+    } catch (...) {
+      next.store(n);
+      std::lock_guard<std::mutex> lock(failed_mutex);
+      if (!failed) failed = std::current_exception();
     }
   };
   std::vector<std::thread> pool;
   for (long t = 1; t < threads; ++t) pool.emplace_back(work);
   work();
   for (std::thread& t : pool) t.join();
+  if (failed) std::rethrow_exception(failed);
 }
 
 }  // namespace sapmvs
