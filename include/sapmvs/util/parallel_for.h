@@ -3,10 +3,11 @@
 //
 // OpenMP's idle workers spin for milliseconds after each parallel region
 // (libgomp's GOMP_SPINCOUNT) on the cores that the OpenCL runtime's threads
-// need for the next kernel; in propagation, which alternates short host loops
-// with kernels, that spinning cost more CPU than the loops saved. The threads
-// here live for one call: starting one costs tens of microseconds, and after
-// the loop nothing is left running.
+// need for the next kernel. In propagation, which alternates short host loops
+// with kernels, OpenMP there doubled libgomp's share of the CPU samples on
+// the simulator's `city` (2.3 to 4.6 %). The threads here live for one call:
+// starting one costs tens of microseconds, and after the loop nothing is
+// left running.
 #include <algorithm>
 #include <atomic>
 #include <exception>
