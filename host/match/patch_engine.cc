@@ -2,13 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <iterator>
-#include <thread>
 
 #include "match/footprint.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/parallel_for.h"
 #include "sapmvs/util/thread_count.h"
 
 namespace sapmvs {
@@ -319,27 +318,14 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::Evaluate(
   constexpr size_t kMinHalf = 256;
   if (candidates.size() < 2 * kMinHalf || HostThreadCount() < 2) return EvaluateBatch(candidates);
   const auto mid = candidates.begin() + static_cast<long>(candidates.size() / 2);
-  const std::vector<PatchCandidate> first(candidates.begin(), mid), second(mid, candidates.end());
-  std::vector<std::optional<AcceptedPatch>> results, rest;
-  std::exception_ptr failed;
-  std::thread other([&] {
-    try {
-      rest = EvaluateBatch(second);
-    } catch (...) {
-      failed = std::current_exception();
-    }
-  });
-  try {
-    results = EvaluateBatch(first);
-  } catch (...) {
-    other.join();
-    throw;
-  }
-  other.join();
-  if (failed) std::rethrow_exception(failed);
-  results.insert(results.end(), std::make_move_iterator(rest.begin()),
-                 std::make_move_iterator(rest.end()));
-  return results;
+  const std::vector<PatchCandidate> halves[2] = {{candidates.begin(), mid},
+                                                 {mid, candidates.end()}};
+  std::vector<std::optional<AcceptedPatch>> results[2];
+  ParallelFor(
+      2, [&](long h) { results[h] = EvaluateBatch(halves[h]); }, 1);
+  results[0].insert(results[0].end(), std::make_move_iterator(results[1].begin()),
+                    std::make_move_iterator(results[1].end()));
+  return std::move(results[0]);
 }
 
 std::vector<std::optional<AcceptedPatch>> PatchEngine::EvaluateBatch(
