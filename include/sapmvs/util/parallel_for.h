@@ -12,6 +12,7 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -46,7 +47,12 @@ void ParallelFor(long n, const F& f, long block = 16) {
     }
   };
   std::vector<std::thread> pool;
-  for (long t = 1; t < threads; ++t) pool.emplace_back(work);
+  try {
+    for (long t = 1; t < threads; ++t) pool.emplace_back(work);
+  } catch (const std::system_error&) {
+    // No thread to be had (a process limit): the threads that did start,
+    // and this one, share the loop.
+  }
   work();
   for (std::thread& t : pool) t.join();
   if (failed) std::rethrow_exception(failed);
