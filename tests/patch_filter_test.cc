@@ -268,13 +268,37 @@ TEST(SeedDepthFences, TukeyFencesPaddedByTenGsdAndNoneBelowTenSeeds) {
   // 20 depths 100..119, shuffled: the fence must not depend on their order.
   for (int i = 0; i < 20; ++i) depths[1].push_back(100.0 + (i * 7) % 20);
   const double gsd = 0.05;
-  const auto fences = SeedDepthFences(depths, gsd);
+  const auto fences = SeedDepthFences(depths, {}, gsd);
   ASSERT_EQ(fences.size(), 2u);
   EXPECT_EQ(fences[0], std::make_pair(0.0, 0.0)) << "9 seeds are too few for a fence";
   // Quartiles of 100..119 at indices 5 and 15: 105 and 115.
   const double pad = 3.0 * (115.0 - 105.0) + 10.0 * gsd;
   EXPECT_DOUBLE_EQ(fences[1].first, 105.0 - pad);
   EXPECT_DOUBLE_EQ(fences[1].second, 115.0 + pad);
+}
+
+// Most seeds on the ground at depth ~500 and a few on a tower's roof at 432
+// (city's 66 m tower): Tukey's near fence would cut the roof; the near fence
+// is where the seed search stopped looking, so the roof stays. The far fence
+// stays Tukey's, which drops the false seeds' clusters behind the ground.
+TEST(SeedDepthFences, NearFenceIsTheSeedSearchsNearEndFarFenceIsTukeys) {
+  std::vector<std::vector<double>> depths(3);
+  for (int i = 0; i < 97; ++i) depths[0].push_back(495.0 + (i * 13) % 11);
+  for (double d : {432.0, 433.0, 990.0}) depths[0].push_back(d);
+  depths[1] = depths[0];
+  depths[2] = depths[0];
+  const double gsd = 0.95;
+  const auto tukey = SeedDepthFences(depths, {}, gsd);
+  EXPECT_GT(tukey[0].first, 432.0) << "Tukey's near fence alone would cut the roof";
+  const auto fences = SeedDepthFences(depths, {250.0, 0.0, 480.0}, gsd);
+  ASSERT_EQ(fences.size(), 3u);
+  EXPECT_DOUBLE_EQ(fences[0].first, 250.0) << "the seed search looked as near as 250";
+  EXPECT_DOUBLE_EQ(fences[1].first, tukey[1].first) << "no search bound given: Tukey's";
+  EXPECT_DOUBLE_EQ(fences[2].first, tukey[2].first) << "a search bound behind Tukey's fence";
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_DOUBLE_EQ(fences[i].second, tukey[i].second);
+    EXPECT_LT(fences[i].second, 990.0) << "the false seed's depth stays outside";
+  }
 }
 
 TEST(ScoreFloor, ThresholdUnlessTheFenceLiesAboveIt) {

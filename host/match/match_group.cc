@@ -188,8 +188,12 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     end_stage("edges");
   }
 
+  std::vector<double> search_near(group.images.size());
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    search_near[i] = kSeedDepthMin * group.images[i].depth;
+  }
   const std::vector<std::pair<double, double>> plausible =
-      SeedDepthFences(propagator.seed_depths(), group.gsd);
+      SeedDepthFences(propagator.seed_depths(), search_near, group.gsd);
   const auto& points = propagator.points();
   const auto& patches = propagator.patches();
   std::vector<bool> keep;

@@ -397,7 +397,8 @@ double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& 
 }
 
 std::vector<std::pair<double, double>> SeedDepthFences(
-    const std::vector<std::vector<double>>& seed_depths, double gsd) {
+    const std::vector<std::vector<double>>& seed_depths, const std::vector<double>& search_near,
+    double gsd) {
   std::vector<std::pair<double, double>> fences(seed_depths.size(), {0.0, 0.0});
   for (size_t i = 0; i < seed_depths.size(); ++i) {
     std::vector<double> d = seed_depths[i];
@@ -405,7 +406,11 @@ std::vector<std::pair<double, double>> SeedDepthFences(
     std::sort(d.begin(), d.end());
     const double q1 = d[d.size() / 4], q3 = d[(3 * d.size()) / 4];
     const double pad = 3.0 * (q3 - q1) + 10.0 * gsd;
-    fences[i] = {q1 - pad, q3 + pad};
+    const double tukey_near = q1 - pad;
+    const double near = i < search_near.size() && search_near[i] > 0
+                            ? std::min(tukey_near, search_near[i])
+                            : tukey_near;
+    fences[i] = {near, q3 + pad};
   }
   return fences;
 }

@@ -44,14 +44,23 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
 double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
                   const std::vector<AcceptedPatch>& patches);
 
-// Per image, the depths a point may lie at in it as its reference: Tukey's
-// fences on the image's seed depths (3 interquartile ranges beyond the
-// quartiles) plus 10 `gsd`; (0, 0) = no fence, when an image has fewer than
-// 10 seeds. A false match can grow into a cluster big enough to pass the
-// cluster filter (on the NGI block, clusters kilometres below the ground);
-// quartiles, not the seeds' extremes, because false seeds are among them.
+// Per image, the depths a point may lie at in it as its reference. Beyond
+// the seeds: Tukey's far fence on the image's seed depths (3 interquartile
+// ranges beyond the third quartile) plus 10 `gsd`. A false match can grow
+// into a cluster big enough to pass the cluster filter (on the NGI block,
+// clusters kilometres below the ground); quartiles, not the seeds'
+// extremes, because false seeds are among them. Those false seeds pile up at
+// the far end of the epipolar search (NGI: 9-10 km behind ground at 5 km;
+// `city`: 800-1000 m behind ground at 500 m), below the ground, where a nadir
+// block has nothing to see. In front of the seeds stand buildings and
+// towers, which few seeds hit: Tukey's near fence cut `city`'s 66 m tower
+// (its roof 13 % nearer than the ground) out of the cloud. So the near
+// fence is the nearer of Tukey's and `search_near[i]`, the nearest depth the
+// seed search looked at (0: none given, Tukey's). (0, 0) = no fence, when an
+// image has fewer than 10 seeds.
 std::vector<std::pair<double, double>> SeedDepthFences(
-    const std::vector<std::vector<double>>& seed_depths, double gsd);
+    const std::vector<std::vector<double>>& seed_depths, const std::vector<double>& search_near,
+    double gsd);
 
 // Clears keep[i] for kept points outside their reference image's fence;
 // returns how many.
