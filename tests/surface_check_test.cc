@@ -229,6 +229,40 @@ TEST(CheckAgainstSurface, BadOptionsThrow) {
   }
 }
 
+// A step: the west half at kZ, the east half 4 higher. Points on both tops,
+// on the wall between them, and off the surface by more or less than the
+// radius, by the wall too.
+TEST(ShareNearSurface, TopsAndWallsAreSurfaceAndTheRadiusIsThreeDimensional) {
+  GeoRaster step = FlatSurface();
+  for (int r = 0; r < kRasterCells; ++r) {
+    for (int c = kRasterCells / 2; c < kRasterCells; ++c) step.at(c, r) = kZ + 4;
+  }
+  const double wall_x = kX0 + kRasterCells / 2 * kRasterCell;  // 1050
+  const double y = 2050.25;
+  PointCloud cloud;
+  auto add = [&](double x, double z) {
+    CloudPoint p;
+    p.position = {x, y, z};
+    cloud.points.push_back(p);
+  };
+  add(1020, kZ);              // west top
+  add(1080, kZ + 4);          // east top
+  add(wall_x, kZ + 2);        // on the wall
+  add(wall_x - 0.1, kZ + 3);  // just west of the wall, on its face
+  add(1020, kZ + 0.9);        // 0.9 above the west top
+  add(1020, kZ + 1.1);        // 1.1 above it
+  add(wall_x - 1.2, kZ + 3);  // 1.2 west of the wall, 3 above the west top
+  add(1200, kZ);              // off the raster
+  const double radius = 1.0;
+  // Near: the two tops, the wall, its face, 0.9 above. Not: 1.1 above, the
+  // point 1.2 from the wall and 3 above the ground, the one off the raster.
+  EXPECT_DOUBLE_EQ(ShareNearSurface(cloud, step, radius), 5.0 / 8.0);
+  EXPECT_DOUBLE_EQ(ShareNearSurface(cloud, step, 1.25), 7.0 / 8.0)
+      << "1.1 above the top and 1.2 from the wall are within 1.25";
+  EXPECT_DOUBLE_EQ(ShareNearSurface(PointCloud{}, step, radius), 0.0);
+  EXPECT_THROW(ShareNearSurface(cloud, step, 0), Error);
+}
+
 }  // namespace
 // Classes on the surface's grid: the north half ground (2), the south-west
 // quarter water (9), the south-east quarter building (6).

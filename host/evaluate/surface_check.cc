@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <string>
+#include <utility>
 
 #include "sapmvs/util/error.h"
 
@@ -263,6 +266,49 @@ WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
   out.centred = centred;
   out.any = any_window;
   return out;
+}
+
+double ShareNearSurface(const PointCloud& cloud, const GeoRaster& surface, double radius) {
+  if (!(radius > 0)) {
+    throw Error("near-surface radius " + std::to_string(radius) + "; expected a positive distance");
+  }
+  if (cloud.points.empty()) return 0;
+  const double cell = surface.cell_size;
+  const int reach = static_cast<int>(std::ceil(radius / cell));
+  auto height = [&](int c, int r) {
+    return c < 0 || r < 0 || c >= surface.width || r >= surface.height || surface.IsEmpty(c, r)
+               ? std::numeric_limits<double>::quiet_NaN()
+               : static_cast<double>(surface.at(c, r));
+  };
+  const long n = static_cast<long>(cloud.points.size());
+  long near = 0;
+#pragma omp parallel for reduction(+ : near) schedule(static)
+  for (long i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = cloud.points[i].position;
+    const int pc = static_cast<int>(std::floor((p.x() - surface.origin_x) / cell));
+    const int pr = static_cast<int>(std::floor((surface.origin_y - p.y()) / cell));
+    if (std::isnan(height(pc, pr))) continue;
+    bool found = false;
+    for (int r = pr - reach; r <= pr + reach && !found; ++r) {
+      for (int c = pc - reach; c <= pc + reach && !found; ++c) {
+        const double top = height(c, r);
+        if (std::isnan(top)) continue;
+        double bottom = top;
+        for (const auto& [dc, dr] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          const double z = height(c + dc, r + dr);
+          if (!std::isnan(z)) bottom = std::min(bottom, z);
+        }
+        // Horizontal distance to the cell's square, vertical to its column.
+        const Eigen::Vector2d centre = surface.CellCenter(c, r);
+        const double dx = std::max(0.0, std::abs(p.x() - centre.x()) - 0.5 * cell);
+        const double dy = std::max(0.0, std::abs(p.y() - centre.y()) - 0.5 * cell);
+        const double dz = p.z() > top ? p.z() - top : (p.z() < bottom ? bottom - p.z() : 0.0);
+        found = dx * dx + dy * dy + dz * dz <= radius * radius;
+      }
+    }
+    near += found;
+  }
+  return static_cast<double>(near) / static_cast<double>(n);
 }
 
 }  // namespace sapmvs

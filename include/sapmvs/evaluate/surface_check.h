@@ -82,6 +82,15 @@ struct WindowBound {
 WindowBound WindowCoverageBound(const GeoRaster& surface, const Block& block,
                                 const SurfaceCheckOptions& options, double radius);
 
+// Share of `cloud`'s points within `radius` (3D) of `surface`, its cells
+// taken as columns: each cell's top spans the cell, and its sides reach down
+// to its lowest 4-neighbour, so that walls count as surface. What any
+// accurate cloud can cover of another cloud at `radius`: the benchmark's
+// ceiling for the share of PMVS2's points with one of ours near them.
+// Points over empty cells or off the raster count as not near. Throws Error
+// for a non-positive radius.
+double ShareNearSurface(const PointCloud& cloud, const GeoRaster& surface, double radius);
+
 // Throws Error for non-positive tolerance or cell size, or a class raster
 // not on the surface's grid.
 SurfaceCheck CheckAgainstSurface(const PointCloud& cloud, const GeoRaster& surface,
