@@ -214,6 +214,122 @@ TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
   EXPECT_GT(candidates, 2 * static_cast<long>(features[0].size()));
 }
 
+// The candidates are ranked by support (the other views with a feature of
+// the same kind within epipolar_distance of the candidate's projection),
+// then by distance from the epipolar line. The support test reads a
+// per-pixel mask before the exact distances: the ranking must be the one
+// the definition gives, with supports just inside and just outside the
+// distance, and of the other kind, in a third image.
+TEST(SeedMatcherTest, RanksCandidatesBySupportAsTheDefinitionDoes) {
+  const test::PlaneScene scene = test::MakePlaneScene(3, 241, 181, 23);
+  MatchGroupData group;
+  for (int i = 0; i < 3; ++i) {
+    MatchImage image;
+    image.camera = scene.cameras[i];
+    for (int j = 0; j < 3; ++j) {
+      if (j != i) image.views.push_back(j);
+    }
+    image.depth = image.camera.Depth(test::GroundAt(image.camera, Eigen::Vector2d(120, 90)));
+    group.images.push_back(image);
+  }
+  MatcherOptions options;
+  options.candidates_per_feature = 100000;  // keep every candidate
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> x(0.0, 240.0), y(0.0, 180.0), angle(0, 2 * M_PI);
+  std::vector<std::vector<Feature>> features(3);
+  for (int k = 0; k < 40; ++k) {
+    Feature f;
+    f.uv = Eigen::Vector2d(x(rng), y(rng));
+    f.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
+    features[0].push_back(f);
+  }
+  for (int j = 1; j < 3; ++j) {
+    for (int k = 0; k < 400; ++k) {
+      Feature g;
+      g.uv = Eigen::Vector2d(x(rng), y(rng));
+      g.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
+      features[j].push_back(g);
+    }
+  }
+  auto inside = [](const Eigen::Vector2d& uv) {
+    return uv.x() >= 0 && uv.y() >= 0 && uv.x() <= 240 && uv.y() <= 180;
+  };
+  for (size_t k = 0; k < features[0].size(); ++k) {
+    const Feature& f = features[0][k];
+    const Eigen::Vector3d ground = test::GroundAt(group.images[0].camera, f.uv);
+    for (int j = 1; j < 3; ++j) {
+      // Its match, and around the match a feature 1.9, 2.0 or 2.1 px away in
+      // a random direction, of its kind or of the other.
+      Feature g = f;
+      g.uv = group.images[j].camera.Project(ground);
+      if (inside(g.uv)) features[j].push_back(g);
+      const double a = angle(rng);
+      g.uv += (1.9 + 0.1 * static_cast<double>(k % 3)) * Eigen::Vector2d(std::cos(a), std::sin(a));
+      if (k % 4 == 3)
+        g.kind = f.kind == FeatureKind::kHarris ? FeatureKind::kDog : FeatureKind::kHarris;
+      if (inside(g.uv)) features[j].push_back(g);
+    }
+  }
+
+  const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  const MatchImage& ref = group.images[0];
+  long compared = 0, supported = 0;
+  for (const Feature& f : features[0]) {
+    // The definition, over every feature: partners in each view, in view
+    // order, then ranked.
+    struct Want {
+      Eigen::Vector3d x;
+      int support;
+      double epipolar;
+    };
+    std::vector<Want> want;
+    for (const int j : ref.views) {
+      const Camera& cam = group.images[j].camera;
+      const Eigen::Vector2d a =
+          cam.Project(ref.camera.BackProject(f.uv, kSeedDepthMin * ref.depth));
+      const Eigen::Vector2d b =
+          cam.Project(ref.camera.BackProject(f.uv, kSeedDepthMax * ref.depth));
+      for (const Feature& g : features[j]) {
+        if (g.kind != f.kind) continue;
+        const double t = (g.uv - a).dot(b - a) / (b - a).squaredNorm();
+        const double dist = (g.uv - (a + t * (b - a))).norm();
+        if (t < 0 || t > 1 || dist > options.epipolar_distance) continue;
+        const Eigen::Vector3d p = TriangulateMidpoint(ref.camera, f.uv, cam, g.uv);
+        const double depth = ref.camera.Depth(p);
+        if (!p.allFinite() || depth < kSeedDepthMin * ref.depth ||
+            depth > kSeedDepthMax * ref.depth) {
+          continue;
+        }
+        int support = 0;
+        for (const int k : ref.views) {
+          if (k == j || !(group.images[k].camera.Depth(p) > 0)) continue;
+          const Eigen::Vector2d q = group.images[k].camera.Project(p);
+          support += std::any_of(features[k].begin(), features[k].end(), [&](const Feature& h) {
+            return h.kind == f.kind && (h.uv - q).norm() <= options.epipolar_distance;
+          });
+        }
+        want.push_back({p, support, dist});
+      }
+    }
+    std::stable_sort(want.begin(), want.end(), [](const Want& p, const Want& q) {
+      return p.support != q.support ? p.support > q.support : p.epipolar < q.epipolar;
+    });
+    const auto found = std::find_if(seeds.begin(), seeds.end(), [&](const SeedFeature& s) {
+      return s.image == 0 && s.uv == f.uv;
+    });
+    const size_t got = found == seeds.end() ? 0 : found->candidates.size();
+    ASSERT_EQ(got, want.size()) << "feature at " << f.uv.transpose();
+    for (size_t k = 0; k < got; ++k) {
+      EXPECT_LT((found->candidates[k].center - want[k].x).norm(), 1e-9)
+          << "feature at " << f.uv.transpose() << ", candidate " << k;
+      supported += want[k].support > 0;
+    }
+    ++compared;
+  }
+  EXPECT_EQ(compared, static_cast<long>(features[0].size()));
+  EXPECT_GT(supported, static_cast<long>(features[0].size())) << "too few supported candidates";
+}
+
 // A view-only image (another strip's, ImageGroup::views) lends its features
 // as partners but starts no seed.
 TEST(SeedMatcherTest, AViewOnlyImageStartsNoSeed) {
