@@ -132,6 +132,17 @@ MatchGroupData TwoImageGroup() {
   return group;
 }
 
+// n features at random over a 241 x 181 image, Harris and DoG in turn.
+void AddRandomFeatures(std::mt19937& rng, int n, std::vector<Feature>* out) {
+  std::uniform_real_distribution<double> x(0.0, 240.0), y(0.0, 180.0);
+  for (int k = 0; k < n; ++k) {
+    Feature f;
+    f.uv = Eigen::Vector2d(x(rng), y(rng));
+    f.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
+    out->push_back(f);
+  }
+}
+
 // Seed matching searches only the features near each epipolar segment (a
 // bucket walk along it, clipped to the image): it must find exactly the
 // candidates a scan of every feature finds, including features just inside
@@ -142,24 +153,13 @@ TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
   MatcherOptions options;
   options.candidates_per_feature = 100000;  // keep every candidate
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> x(0.0, 240.0), y(0.0, 180.0);
   std::vector<std::vector<Feature>> features(2);
   // Image 0: features all over it, near its borders too.
-  for (int k = 0; k < 60; ++k) {
-    Feature f;
-    f.uv = Eigen::Vector2d(x(rng), y(rng));
-    f.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
-    features[0].push_back(f);
-  }
+  AddRandomFeatures(rng, 60, &features[0]);
   // Image 1: random features, plus for each feature of image 0 its match on
   // the ground and features 1.9 and 2.1 px across its epipolar line, and one
   // of the other kind on the line; all inside the image, as detected ones are.
-  for (int k = 0; k < 1500; ++k) {
-    Feature g;
-    g.uv = Eigen::Vector2d(x(rng), y(rng));
-    g.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
-    features[1].push_back(g);
-  }
+  AddRandomFeatures(rng, 1500, &features[1]);
   const Camera& c0 = group.images[0].camera;
   const Camera& c1 = group.images[1].camera;
   for (const Feature& f : features[0]) {
@@ -235,22 +235,10 @@ TEST(SeedMatcherTest, RanksCandidatesBySupportAsTheDefinitionDoes) {
   MatcherOptions options;
   options.candidates_per_feature = 100000;  // keep every candidate
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> x(0.0, 240.0), y(0.0, 180.0), angle(0, 2 * M_PI);
+  std::uniform_real_distribution<double> angle(0, 2 * M_PI);
   std::vector<std::vector<Feature>> features(3);
-  for (int k = 0; k < 40; ++k) {
-    Feature f;
-    f.uv = Eigen::Vector2d(x(rng), y(rng));
-    f.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
-    features[0].push_back(f);
-  }
-  for (int j = 1; j < 3; ++j) {
-    for (int k = 0; k < 400; ++k) {
-      Feature g;
-      g.uv = Eigen::Vector2d(x(rng), y(rng));
-      g.kind = k % 2 == 0 ? FeatureKind::kHarris : FeatureKind::kDog;
-      features[j].push_back(g);
-    }
-  }
+  AddRandomFeatures(rng, 40, &features[0]);
+  for (int j = 1; j < 3; ++j) AddRandomFeatures(rng, 400, &features[j]);
   auto inside = [](const Eigen::Vector2d& uv) {
     return uv.x() >= 0 && uv.y() >= 0 && uv.x() <= 240 && uv.y() <= 180;
   };
