@@ -14,7 +14,7 @@ namespace {
 // Points per write call: a few MB at most.
 constexpr size_t kPlyWriteChunk = 1 << 16;
 
-std::string PlyHeader(const PointCloud& format, const PlyCounts& counts, size_t* record) {
+std::string PlyHeaderText(const PointCloud& format, const PlyCounts& counts, size_t* record) {
   std::ostringstream header;
   header << "ply\nformat binary_little_endian 1.0\ncomment written by sapmvs\n";
   if (!format.crs.empty()) {
@@ -64,7 +64,7 @@ void PlyCounts::Add(const std::string& file, const CloudPoint& p, bool has_views
 void WritePlyStream(const std::filesystem::path& path, const PointCloud& format,
                     const PlyCounts& counts, const NextPoints& next) {
   size_t record = 0;
-  const std::string header = PlyHeader(format, counts, &record);
+  const std::string header = PlyHeaderText(format, counts, &record);
   WriteStreamAtomically(path, [&](std::ostream& out) {
     out.write(header.data(), static_cast<std::streamsize>(header.size()));
     std::vector<uint8_t> buffer;
