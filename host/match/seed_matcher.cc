@@ -14,79 +14,80 @@ namespace {
 // each query reads only those.
 class FeatureIndex {
  public:
-  // `near_radius`: the radius Near will be asked about.
-  FeatureIndex(const std::vector<Feature>& features, int width, int height, double near_radius)
+  // `radius` (<= kCell): the distance every query asks about.
+  FeatureIndex(const std::vector<Feature>& features, int width, int height, double radius)
       : features_(features),
         cols_(width / kCell + 1),
         rows_(height / kCell + 1),
         width_(width),
         height_(height),
-        near_radius_(near_radius) {
-    for (auto& b : buckets_) b.resize(static_cast<size_t>(cols_) * rows_);
-    for (auto& m : maybe_near_) m.assign((static_cast<size_t>(width) * height + 63) / 64, 0);
-    // A point within near_radius of a feature has its nearest pixel centre
-    // within near_radius + sqrt(1/2) of it.
-    const double reach = near_radius + 0.7072;
+        radius_(radius) {
+    for (KindGrid& g : grids_) {
+      g.buckets.resize(static_cast<size_t>(cols_) * rows_);
+      g.maybe_near.assign((static_cast<size_t>(width) * height + 63) / 64, 0);
+    }
+    // A point within radius of a feature has its nearest pixel centre
+    // within radius + sqrt(1/2) of it.
+    const double reach = radius + 0.7072;
     const int span = static_cast<int>(std::ceil(reach));
     for (size_t i = 0; i < features.size(); ++i) {
       const Feature& f = features[i];
       const int cx = std::clamp(static_cast<int>(f.uv.x()) / kCell, 0, cols_ - 1);
       const int cy = std::clamp(static_cast<int>(f.uv.y()) / kCell, 0, rows_ - 1);
-      Buckets(f.kind)[static_cast<size_t>(cy) * cols_ + cx].push_back(static_cast<int>(i));
-      std::vector<uint64_t>& mask = maybe_near_[f.kind == FeatureKind::kDog ? 1 : 0];
+      KindGrid& grid = grids_[static_cast<int>(f.kind)];
+      grid.buckets[static_cast<size_t>(cy) * cols_ + cx].push_back(static_cast<int>(i));
       const int fx = static_cast<int>(std::lround(f.uv.x()));
       const int fy = static_cast<int>(std::lround(f.uv.y()));
       for (int y = std::max(fy - span, 0); y <= std::min(fy + span, height - 1); ++y) {
         for (int x = std::max(fx - span, 0); x <= std::min(fx + span, width - 1); ++x) {
           if ((Eigen::Vector2d(x, y) - f.uv).norm() <= reach) {
             const size_t bit = static_cast<size_t>(y) * width + x;
-            mask[bit / 64] |= uint64_t{1} << (bit % 64);
+            grid.maybe_near[bit / 64] |= uint64_t{1} << (bit % 64);
           }
         }
       }
     }
   }
-  // True when a feature of `kind` lies within `radius` (<= kCell) of uv.
+  // True when a feature of `kind` lies within the radius of uv.
   // The support counts ask this 92 million times on Herz-Jesu-P8, nine in
   // ten times of a point with no feature near: a per-pixel mask answers
   // those, and only the buckets the disc overlaps are read for the rest.
-  bool Near(const Eigen::Vector2d& uv, FeatureKind kind, double radius) const {
+  bool Near(const Eigen::Vector2d& uv, FeatureKind kind) const {
+    const KindGrid& grid = grids_[static_cast<int>(kind)];
     const int px = static_cast<int>(std::lround(uv.x()));
     const int py = static_cast<int>(std::lround(uv.y()));
-    if (radius <= near_radius_ && px >= 0 && py >= 0 && px < width_ && py < height_) {
+    if (px >= 0 && py >= 0 && px < width_ && py < height_) {
       const size_t bit = static_cast<size_t>(py) * width_ + px;
-      if (!(maybe_near_[kind == FeatureKind::kDog ? 1 : 0][bit / 64] >> (bit % 64) & 1)) {
-        return false;
-      }
+      if (!(grid.maybe_near[bit / 64] >> (bit % 64) & 1)) return false;
     }
-    const std::vector<std::vector<int>>& buckets = Buckets(kind);
-    const int x0 = std::max(static_cast<int>(std::floor((uv.x() - radius) / kCell)), 0);
-    const int x1 = std::min(static_cast<int>(std::floor((uv.x() + radius) / kCell)), cols_ - 1);
-    const int y0 = std::max(static_cast<int>(std::floor((uv.y() - radius) / kCell)), 0);
-    const int y1 = std::min(static_cast<int>(std::floor((uv.y() + radius) / kCell)), rows_ - 1);
+    const int x0 = std::max(static_cast<int>(std::floor((uv.x() - radius_) / kCell)), 0);
+    const int x1 = std::min(static_cast<int>(std::floor((uv.x() + radius_) / kCell)), cols_ - 1);
+    const int y0 = std::max(static_cast<int>(std::floor((uv.y() - radius_) / kCell)), 0);
+    const int y1 = std::min(static_cast<int>(std::floor((uv.y() + radius_) / kCell)), rows_ - 1);
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
-        for (const int i : buckets[static_cast<size_t>(y) * cols_ + x]) {
-          if ((features_[i].uv - uv).norm() <= radius) return true;
+        for (const int i : grid.buckets[static_cast<size_t>(y) * cols_ + x]) {
+          if ((features_[i].uv - uv).norm() <= radius_) return true;
         }
       }
     }
     return false;
   }
   // The indices, ascending, of every feature of `kind` that may lie within
-  // `radius` of the segment a-b: those in the buckets within reach of points
-  // sampled along it whose square comes within `radius` of its line (a
-  // superset; the caller applies the exact test).
+  // the radius of the segment a-b: those in the buckets within reach of
+  // points sampled along it whose square comes within the radius of its line
+  // (a superset; the caller applies the exact test).
   // `seen` is the caller's scratch (one per thread): a visit stamp per
   // bucket, so that buckets reached from several samples count once.
   struct Scratch {
     std::vector<uint32_t> seen;
     uint32_t stamp = 0;
   };
-  void Along(const Eigen::Vector2d& a, const Eigen::Vector2d& b, FeatureKind kind, double radius,
-             Scratch* scratch, std::vector<int>* out) const {
+  void Along(const Eigen::Vector2d& a, const Eigen::Vector2d& b, FeatureKind kind, Scratch* scratch,
+             std::vector<int>* out) const {
     out->clear();
-    const std::vector<std::vector<int>>& buckets = Buckets(kind);
+    const double radius = radius_;
+    const std::vector<std::vector<int>>& buckets = grids_[static_cast<int>(kind)].buckets;
     if (scratch->seen.size() != buckets.size() || scratch->stamp == UINT32_MAX) {
       scratch->seen.assign(buckets.size(), 0);
       scratch->stamp = 0;
@@ -159,22 +160,20 @@ class FeatureIndex {
   }
 
  private:
-  const std::vector<std::vector<int>>& Buckets(FeatureKind kind) const {
-    return buckets_[kind == FeatureKind::kDog ? 1 : 0];
-  }
-  std::vector<std::vector<int>>& Buckets(FeatureKind kind) {
-    return buckets_[kind == FeatureKind::kDog ? 1 : 0];
-  }
+  // One kind's features.
+  struct KindGrid {
+    std::vector<std::vector<int>> buckets;
+    // A bit per pixel: 0 = no feature within radius_ of any point whose
+    // nearest pixel this is (200 kB for 1536 x 1024 pixels).
+    std::vector<uint64_t> maybe_near;
+  };
 
   static constexpr int kCell = 8;
   const std::vector<Feature>& features_;
   int cols_, rows_;
   int width_, height_;
-  double near_radius_;
-  std::vector<std::vector<int>> buckets_[2];  // by kind: Harris, DoG
-  // By kind, a bit per pixel: 0 = no feature within near_radius_ of any
-  // point whose nearest pixel this is (200 kB for 1536 x 1024 pixels).
-  std::vector<uint64_t> maybe_near_[2];
+  double radius_;
+  KindGrid grids_[2];  // by FeatureKind: Harris, DoG
 };
 
 // A partner's triangulated point and rank; the candidate itself is built
@@ -240,10 +239,9 @@ std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
       // all of them met them (the sort below keeps ties in that order):
       // the scan cost features x features per pair of images, 22 s of
       // host time on Herz-Jesu-P8 at level 1.
-      index[j].Along(a, b, f.kind, options.epipolar_distance, &scratch, &near_segment);
+      index[j].Along(a, b, f.kind, &scratch, &near_segment);
       for (const int gi : near_segment) {
-        const Feature& g = features[j][gi];
-        if (g.kind != f.kind) continue;
+        const Feature& g = features[j][gi];  // of f's kind
         const double t = (g.uv - a).dot(dir) / len2;
         if (t < 0 || t > 1) continue;
         const double dist = (g.uv - (a + t * dir)).norm();
@@ -259,7 +257,7 @@ std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
           if (k == j) continue;
           const Camera& ck = group.images[k].camera;
           if (!(ck.Depth(x) > 0)) continue;
-          if (index[k].Near(ck.Project(x), f.kind, options.epipolar_distance)) ++s.support;
+          if (index[k].Near(ck.Project(x), f.kind)) ++s.support;
         }
         scored.push_back(s);
       }
