@@ -1,7 +1,5 @@
 #include "match/patch_filter.h"
 
-#include <flann/flann.hpp>
-
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -11,7 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "match/footprint.h"
-#include "sapmvs/util/error.h"
+#include "match/point_neighbours.h"
 
 namespace sapmvs {
 namespace {
@@ -194,10 +192,6 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   for (size_t a = 0; a < alive.size(); ++a) {
     for (int c = 0; c < 3; ++c) xyz[3 * a + c] = static_cast<float>(points[alive[a]].x[c]);
   }
-  const int k = static_cast<int>(std::min<size_t>(kNeighbours + 1, alive.size()));
-  flann::Matrix<float> data(xyz.data(), alive.size(), 3);
-  flann::Index<flann::L2<float>> index(data, flann::KDTreeSingleIndexParams(10));
-  index.buildIndex();
   // Each point's footprint in its reference image, the unit of the plane
   // distances below, and its neighbour radius: neighbour_radius footprints
   // along its plane's slope, so that a surface seen obliquely, whose points
@@ -211,39 +205,11 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     footprint[a] = Footprint(camera, p.x);
     radius[a] = options.neighbour_radius * SlopeFootprint(camera, p.x, patch.normal);
   }
-  // nn[a * k + j]: the j-th nearest neighbour of point a when it lies within
-  // a's radius and is not a itself, else -1. Searched in chunks, so that
-  // FLANN's size_t indices and distances exist for one chunk only: whole,
-  // they were 80 % of the filter's memory and set the group's peak.
-  constexpr size_t kChunk = 16384;
-  if (alive.size() > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
-    throw Error("filter: " + std::to_string(alive.size()) +
-                " points in one group, more than its neighbour index holds (2^31 - 1)");
-  }
-  std::vector<int32_t> nn(alive.size() * k, -1);
-  {
-    std::vector<size_t> chunk_nn(kChunk * k);
-    std::vector<float> chunk_nd(kChunk * k);
-    flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
-    params.cores = 0;
-    for (size_t first = 0; first < alive.size(); first += kChunk) {
-      const size_t rows = std::min(kChunk, alive.size() - first);
-      flann::Matrix<float> queries(xyz.data() + 3 * first, rows, 3);
-      flann::Matrix<size_t> nn_m(chunk_nn.data(), rows, k);
-      flann::Matrix<float> nd_m(chunk_nd.data(), rows, k);
-      index.knnSearch(queries, nn_m, nd_m, k, params);
-#pragma omp parallel for schedule(static)
-      for (size_t r = 0; r < rows; ++r) {
-        const size_t a = first + r;
-        const float r2 = static_cast<float>(radius[a] * radius[a]);
-        for (int j = 0; j < k; ++j) {
-          const size_t b = chunk_nn[r * k + j];
-          if (b == a || chunk_nd[r * k + j] > r2) continue;
-          nn[a * k + j] = static_cast<int32_t>(b);
-        }
-      }
-    }
-  }
+  // nn[a * k + j]: the j-th nearest neighbour of point a within a's radius,
+  // or -1.
+  const int k = kNeighbours;
+  const std::vector<int32_t> nn = NearestWithin(xyz, radius, k);
+  radius = {};
 
   // Distances, in footprints, from each patch's plane to the points of other
   // patches among its points' neighbours (NaN for the other neighbours): the

@@ -1,0 +1,215 @@
+#include "match/point_neighbours.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+namespace {
+
+// A grid column has a cell per `cell` along the cloud's two widest axes; at
+// most this many columns per point (plus a floor for tiny clouds), so that a
+// sparse cloud over a wide block does not allocate a column per empty cell.
+constexpr size_t kColumnsPerPoint = 4;
+constexpr size_t kMinColumns = 1024;
+
+// A point in a column, with its cell along the column.
+struct Entry {
+  float x, y, z;
+  int32_t w;
+  int32_t index;
+};
+
+// The squared distance exactly as FLANN's L2<float> summed it (query minus
+// point, x then y then z), so that a neighbour at the radius is in or out as
+// it was.
+inline float SquaredDistance(const float* q, const Entry& e) {
+  float d2 = 0;
+  const float dx = q[0] - e.x, dy = q[1] - e.y, dz = q[2] - e.z;
+  d2 += dx * dx;
+  d2 += dy * dy;
+  d2 += dz * dz;
+  return d2;
+}
+
+class ColumnGrid {
+ public:
+  ColumnGrid(const std::vector<float>& xyz, double cell_hint) {
+    const size_t n = xyz.size() / 3;
+    std::array<double, 3> lo, hi;
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (size_t a = 0; a < n; ++a) {
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], static_cast<double>(xyz[3 * a + c]));
+        hi[c] = std::max(hi[c], static_cast<double>(xyz[3 * a + c]));
+      }
+    }
+    // The column runs along the axis the cloud spans least: a terrain's
+    // height, a facade's depth.
+    std::array<int, 3> axes = {0, 1, 2};
+    std::sort(axes.begin(), axes.end(),
+              [&](int a, int b) { return hi[a] - lo[a] > hi[b] - lo[b]; });
+    u_ = axes[0], v_ = axes[1], w_ = axes[2];
+    lo_ = lo;
+    const double eu = hi[u_] - lo[u_], ev = hi[v_] - lo[v_];
+    const double max_columns = static_cast<double>(std::max(kColumnsPerPoint * n, kMinColumns));
+    cell_ = cell_hint > 0 ? cell_hint : std::max({eu, ev, hi[w_] - lo[w_], 1.0});
+    cell_ = std::max(cell_, std::sqrt(eu * ev / max_columns));
+    while ((std::floor(eu / cell_) + 1) * (std::floor(ev / cell_) + 1) > max_columns) cell_ *= 1.25;
+    nu_ = static_cast<int>(std::floor(eu / cell_)) + 1;
+    nv_ = static_cast<int>(std::floor(ev / cell_)) + 1;
+    nw_ = static_cast<int>(std::min(std::floor((hi[w_] - lo[w_]) / cell_) + 1, 1e9));
+
+    // Counting sort by column, then each column by (cell along it, index).
+    std::vector<int32_t> column(n);
+    start_.assign(static_cast<size_t>(nu_) * nv_ + 1, 0);
+    for (size_t a = 0; a < n; ++a) {
+      const float* p = &xyz[3 * a];
+      column[a] = Cell(p[u_], u_, nu_) * nv_ + Cell(p[v_], v_, nv_);
+      ++start_[column[a] + 1];
+    }
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    entries_.resize(n);
+    std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (size_t a = 0; a < n; ++a) {
+      const float* p = &xyz[3 * a];
+      entries_[fill[column[a]]++] =
+          Entry{p[0], p[1], p[2], Cell(p[w_], w_, nw_), static_cast<int32_t>(a)};
+    }
+    const long columns = static_cast<long>(start_.size()) - 1;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (long c = 0; c < columns; ++c) {
+      std::sort(entries_.begin() + start_[c], entries_.begin() + start_[c + 1],
+                [](const Entry& a, const Entry& b) {
+                  return a.w != b.w ? a.w < b.w : a.index < b.index;
+                });
+    }
+  }
+
+  // Writes to `out` (k slots) the at most k points nearest to p, other than
+  // point `self`, whose squared distance is at most r2, nearest first (ties
+  // by index); the rest -1. Columns are visited in rings around p's and
+  // skipped once they lie farther than the k-th point found, so that a
+  // point among many others reads little more than its own ring.
+  void Nearest(const float* p, int32_t self, float r2, double reach, int k, int32_t* out,
+               std::vector<std::pair<float, int32_t>>* best) const {
+    best->clear();
+    const int u0 = Cell(p[u_] - reach, u_, nu_), u1 = Cell(p[u_] + reach, u_, nu_);
+    const int v0 = Cell(p[v_] - reach, v_, nv_), v1 = Cell(p[v_] + reach, v_, nv_);
+    const int w0 = Cell(p[w_] - reach, w_, nw_), w1 = Cell(p[w_] + reach, w_, nw_);
+    const int cu = Cell(p[u_], u_, nu_), cv = Cell(p[v_], v_, nv_);
+    const int rings = std::max({cu - u0, u1 - cu, cv - v0, v1 - cv});
+    // The bar a point must pass: within the radius, and once k are held,
+    // nearer than the farthest of them.
+    auto full = [&] { return static_cast<int>(best->size()) == k; };
+    auto visit = [&](int iu, int iv) {
+      if (full()) {
+        // The column's nearest possible point, a little nearer than exact,
+        // so that rounding never skips a point that would have counted.
+        const double du =
+            std::max({0.0, lo_[u_] + iu * cell_ - p[u_], p[u_] - (lo_[u_] + (iu + 1) * cell_)});
+        const double dv =
+            std::max({0.0, lo_[v_] + iv * cell_ - p[v_], p[v_] - (lo_[v_] + (iv + 1) * cell_)});
+        if ((du * du + dv * dv) * (1 - 1e-5) > best->back().first) return;
+      }
+      const size_t c = static_cast<size_t>(iu) * nv_ + iv;
+      auto it = entries_.begin() + start_[c];
+      const auto end = entries_.begin() + start_[c + 1];
+      if (it == end) return;
+      it = std::lower_bound(it, end, w0, [](const Entry& e, int w) { return e.w < w; });
+      for (; it != end && it->w <= w1; ++it) {
+        if (it->index == self) continue;
+        const float d2 = SquaredDistance(p, *it);
+        if (!(d2 <= r2)) continue;
+        const std::pair<float, int32_t> x(d2, it->index);
+        if (full()) {
+          if (!(x < best->back())) continue;
+          best->pop_back();
+        }
+        best->insert(std::upper_bound(best->begin(), best->end(), x), x);
+      }
+    };
+    for (int ring = 0; ring <= rings; ++ring) {
+      for (int iu = std::max(u0, cu - ring); iu <= std::min(u1, cu + ring); ++iu) {
+        const bool edge_u = iu == cu - ring || iu == cu + ring;
+        for (int iv = std::max(v0, cv - ring); iv <= std::min(v1, cv + ring); ++iv) {
+          // Only the ring's own columns: its first and last rows whole, the
+          // others at their two ends.
+          if (!edge_u && iv != cv - ring && iv != cv + ring) {
+            if (iv < cv + ring) iv = cv + ring - 1;
+            continue;
+          }
+          visit(iu, iv);
+        }
+      }
+    }
+    for (size_t j = 0; j < best->size(); ++j) out[j] = (*best)[j].second;
+  }
+
+ private:
+  int Cell(double x, int axis, int cells) const {
+    const double c = std::floor((x - lo_[axis]) / cell_);
+    return static_cast<int>(std::clamp(c, 0.0, static_cast<double>(cells - 1)));
+  }
+
+  std::array<double, 3> lo_{};
+  int u_ = 0, v_ = 1, w_ = 2;
+  double cell_ = 1;
+  int nu_ = 1, nv_ = 1, nw_ = 1;
+  std::vector<uint32_t> start_;  // column c's entries: [start_[c], start_[c + 1])
+  std::vector<Entry> entries_;
+};
+
+}  // namespace
+
+std::vector<int32_t> NearestWithin(const std::vector<float>& xyz, const std::vector<double>& radius,
+                                   int k) {
+  const size_t n = radius.size();
+  if (xyz.size() != 3 * n) {
+    throw Error("NearestWithin: expected 3 coordinates per radius (" + std::to_string(xyz.size()) +
+                " coordinates, " + std::to_string(n) + " radii)");
+  }
+  if (k < 1) throw Error("NearestWithin: expected k >= 1 (k = " + std::to_string(k) + ")");
+  if (n > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+    throw Error("NearestWithin: " + std::to_string(n) +
+                " points, more than an int32 index holds (2^31 - 1)");
+  }
+  for (const double r : radius) {
+    if (!(r >= 0 && std::isfinite(r))) {
+      throw Error("NearestWithin: expected finite radii >= 0 (radius = " + std::to_string(r) + ")");
+    }
+  }
+  std::vector<int32_t> out(n * static_cast<size_t>(k), -1);
+  if (n == 0) return out;
+  // Half the median radius: the cells a radius reaches (about 5 x 5
+  // columns) then hold a few points each.
+  std::vector<double> sorted = radius;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const ColumnGrid grid(xyz, 0.5 * sorted[n / 2]);
+  sorted = {};
+
+#pragma omp parallel
+  {
+    std::vector<std::pair<float, int32_t>> best;
+    best.reserve(k);
+#pragma omp for schedule(dynamic, 512)
+    for (size_t a = 0; a < n; ++a) {
+      const float* q = &xyz[3 * a];
+      // Padded, so that a point whose float distance rounds to within the
+      // radius is never in a cell beyond the box.
+      const double reach =
+          radius[a] * (1 + 1e-5) + 1e-6 * (std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2]) + 1);
+      grid.Nearest(q, static_cast<int32_t>(a), static_cast<float>(radius[a] * radius[a]), reach, k,
+                   &out[a * k], &best);
+    }
+  }
+  return out;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,28 @@
+#pragma once
+// Each point's nearest others within a radius of its own: the neighbourhoods
+// the filter's plane, patch-support and cluster tests read.
+//
+// FLANN's kd-tree answered "the k nearest" until the eighteenth stop, and the
+// filter then dropped those beyond the radius. Its build is serial (one core
+// idle for a tenth of a second per filter pass on the simulator's `city`)
+// and its results, in size_t, were searched in chunks to bound their memory.
+// The radius is known before the search, so a grid of cells half a median
+// radius wide finds the same neighbours with an O(n) build: points lie on
+// surfaces, so the grid is dense in the two axes the cloud spans most and
+// sorted along the third. Columns are read in rings around the point's and
+// skipped once they lie beyond the k-th nearest found so far.
+#include <cstdint>
+#include <vector>
+
+namespace sapmvs {
+
+// For every point a of `xyz` (x, y, z of point a at 3a..3a+2): the indices of
+// at most `k` other points b whose squared distance, summed in float in x, y,
+// z order, is at most float(radius[a]^2), nearest first (ties by index);
+// row a is out[a * k .. a * k + k), padded with -1. Throws Error when the
+// sizes disagree, k < 1, a radius is negative or not finite, or there are
+// more than 2^31 - 1 points.
+std::vector<int32_t> NearestWithin(const std::vector<float>& xyz, const std::vector<double>& radius,
+                                   int k);
+
+}  // namespace sapmvs

@@ -1,0 +1,124 @@
+#include "match/point_neighbours.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+namespace {
+
+// The definition, by a scan of every pair: the k nearest others within the
+// point's radius, distances summed in float in x, y, z order, ties by index.
+std::vector<int32_t> ScanAll(const std::vector<float>& xyz, const std::vector<double>& radius,
+                             int k) {
+  const size_t n = radius.size();
+  std::vector<int32_t> out(n * k, -1);
+  for (size_t a = 0; a < n; ++a) {
+    const float r2 = static_cast<float>(radius[a] * radius[a]);
+    std::vector<std::pair<float, int32_t>> near;
+    for (size_t b = 0; b < n; ++b) {
+      if (b == a) continue;
+      float d2 = 0;
+      for (int c = 0; c < 3; ++c) {
+        const float d = xyz[3 * a + c] - xyz[3 * b + c];
+        d2 += d * d;
+      }
+      if (d2 <= r2) near.emplace_back(d2, static_cast<int32_t>(b));
+    }
+    std::sort(near.begin(), near.end());
+    for (size_t j = 0; j < near.size() && j < static_cast<size_t>(k); ++j) {
+      out[a * k + j] = near[j].second;
+    }
+  }
+  return out;
+}
+
+void ExpectSameAsScan(const std::vector<float>& xyz, const std::vector<double>& radius, int k) {
+  const std::vector<int32_t> got = NearestWithin(xyz, radius, k);
+  const std::vector<int32_t> want = ScanAll(xyz, radius, k);
+  ASSERT_EQ(got.size(), want.size());
+  long differ = 0;
+  for (size_t i = 0; i < got.size(); ++i) differ += got[i] != want[i];
+  EXPECT_EQ(differ, 0) << "of " << got.size() << " slots (" << radius.size() << " points, k = " << k
+                       << ")";
+}
+
+// Layers of points over a rough surface, as overlapping patches emit them,
+// with radii that vary per point as slope footprints do.
+TEST(NearestWithin, FindsWhatAScanOfEveryPairFinds) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0, 1);
+  for (const int n : {1, 2, 17, 333, 2501}) {
+    std::vector<float> xyz;
+    std::vector<double> radius;
+    const float side = std::sqrt(static_cast<float>(n)) * 0.7f;
+    for (int i = 0; i < n; ++i) {
+      const float x = u(rng) * side, y = u(rng) * side;
+      xyz.insert(xyz.end(), {x + 1000.f, y - 500.f, 0.2f * std::sin(x) + 0.05f * u(rng) + 80.f});
+      radius.push_back(0.5 + 3.0 * u(rng));
+    }
+    for (const int k : {1, 5, 16}) ExpectSameAsScan(xyz, radius, k);
+  }
+}
+
+// Equal distances (a lattice, and points repeated at one place) are ordered
+// by index; a radius exactly at a lattice distance keeps that neighbour; a
+// radius of 0 keeps only repeats.
+TEST(NearestWithin, TiesGoByIndexAndTheRadiusIsInclusive) {
+  std::vector<float> xyz;
+  std::vector<double> radius;
+  for (int y = 0; y < 9; ++y) {
+    for (int x = 0; x < 11; ++x) {
+      xyz.insert(xyz.end(), {static_cast<float>(x), static_cast<float>(y), 3.f});
+      radius.push_back((x + y) % 3 == 0 ? 1.0 : (x + y) % 3 == 1 ? 2.0 : 0.0);
+    }
+  }
+  for (int rep = 0; rep < 3; ++rep) {
+    xyz.insert(xyz.end(), {4.f, 4.f, 3.f});
+    radius.push_back(rep == 0 ? 0.0 : 1.5);
+  }
+  for (const int k : {1, 4, 9}) ExpectSameAsScan(xyz, radius, k);
+  const std::vector<int32_t> nn = NearestWithin(xyz, radius, 4);
+  // (0, 0), radius 1: (1, 0) and (0, 1) at distance 1, the smaller index first.
+  EXPECT_EQ(nn[0], 1);
+  EXPECT_EQ(nn[1], 11);
+  EXPECT_EQ(nn[2], -1);
+  // (4, 4), radius 0: only the three points repeated at its place.
+  EXPECT_EQ(std::vector<int32_t>(nn.begin() + 48 * 4, nn.begin() + 49 * 4),
+            (std::vector<int32_t>{99, 100, 101, -1}));
+}
+
+// Clouds the grid's shape must not trip on: a vertical wall (its column
+// along x), a line, one place, and two clusters far apart, whose bounding
+// box would ask for far more columns than points.
+TEST(NearestWithin, WallsLinesOnePlaceAndFarClusters) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<float> wall, line, place, far;
+  for (int i = 0; i < 400; ++i) {
+    wall.insert(wall.end(), {5.f + 0.01f * u(rng), 20 * u(rng), 10 * u(rng)});
+    line.insert(line.end(), {static_cast<float>(i) * 0.5f, 0.f, 0.f});
+    place.insert(place.end(), {1.f, 2.f, 3.f});
+    const float off = i % 2 ? 1e5f : 0.f;
+    far.insert(far.end(), {off + 3 * u(rng), off + 3 * u(rng), u(rng)});
+  }
+  const std::vector<double> radius(400, 1.3);
+  for (const auto* xyz : {&wall, &line, &place, &far}) ExpectSameAsScan(*xyz, radius, 7);
+}
+
+TEST(NearestWithin, RefusesMismatchedSizesAndBadRadii) {
+  EXPECT_THROW(NearestWithin({1, 2, 3, 4}, {1.0}, 4), Error);
+  EXPECT_THROW(NearestWithin({1, 2, 3}, {1.0}, 0), Error);
+  EXPECT_THROW(NearestWithin({1, 2, 3}, {-1.0}, 4), Error);
+  EXPECT_THROW(NearestWithin({1, 2, 3}, {std::nan("")}, 4), Error);
+  EXPECT_TRUE(NearestWithin({}, {}, 4).empty());
+}
+
+}  // namespace
+}  // namespace sapmvs
