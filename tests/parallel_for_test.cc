@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <set>
 #include <stdexcept>
@@ -24,6 +25,36 @@ TEST(ParallelFor, CallsEveryIndexOnceWhateverTheBlock) {
       for (long i = 0; i < n; ++i) {
         ASSERT_EQ(calls[i].load(), 1) << "n " << n << " block " << block << " index " << i;
       }
+    }
+  }
+}
+
+// max_threads caps the calls running at once (tie-point SIFT holds a large
+// pyramid per call), and 1 runs them all on the caller's thread.
+TEST(ParallelFor, MaxThreadsCapsTheCallsAtOnce) {
+  for (const int cap : {1, 2}) {
+    std::atomic<int> running{0}, most{0};
+    std::set<std::thread::id> ids;
+    std::mutex m;
+    ParallelFor(
+        40,
+        [&](long) {
+          const int now = running.fetch_add(1) + 1;
+          int seen = most.load();
+          while (now > seen && !most.compare_exchange_weak(seen, now)) {
+          }
+          {
+            std::lock_guard<std::mutex> lock(m);
+            ids.insert(std::this_thread::get_id());
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+          running.fetch_sub(1);
+        },
+        1, cap);
+    EXPECT_LE(most.load(), cap);
+    EXPECT_LE(static_cast<int>(ids.size()), cap);
+    if (cap == 1) {
+      EXPECT_TRUE(ids.count(std::this_thread::get_id()));
     }
   }
 }

@@ -21,13 +21,15 @@
 namespace sapmvs {
 
 // Calls f(i) once for every i in [0, n), on up to HostThreadCount() threads
-// (the caller's among them), `block` consecutive indices at a time; calls
+// (the caller's among them; fewer when max_threads > 0 is smaller), `block`
+// consecutive indices at a time; calls
 // for different i may run at once. When a call throws, the indices not yet
 // started are skipped and the first exception is rethrown here, after every
 // thread has stopped.
 template <typename F>
-void ParallelFor(long n, const F& f, long block = 16) {
-  const long threads = std::min<long>(HostThreadCount(), (n + block - 1) / block);
+void ParallelFor(long n, const F& f, long block = 16, int max_threads = 0) {
+  long threads = std::min<long>(HostThreadCount(), (n + block - 1) / block);
+  if (max_threads > 0) threads = std::min<long>(threads, max_threads);
   if (threads <= 1) {
     for (long i = 0; i < n; ++i) f(i);
     return;
