@@ -58,7 +58,11 @@ class ColumnGrid {
     u_ = axes[0], v_ = axes[1], w_ = axes[2];
     lo_ = lo;
     const double eu = hi[u_] - lo[u_], ev = hi[v_] - lo[v_];
-    const double max_columns = static_cast<double>(std::max(kColumnsPerPoint * n, kMinColumns));
+    // Column numbers are int32 (NearestWithin allows up to 2^31 - 1 points,
+    // four columns each would not fit).
+    const double max_columns =
+        std::min(static_cast<double>(std::max(kColumnsPerPoint * n, kMinColumns)),
+                 static_cast<double>(std::numeric_limits<int32_t>::max()));
     cell_ = cell_hint > 0 ? cell_hint : std::max({eu, ev, hi[w_] - lo[w_], 1.0});
     cell_ = std::max(cell_, std::sqrt(eu * ev / max_columns));
     while ((std::floor(eu / cell_) + 1) * (std::floor(ev / cell_) + 1) > max_columns) cell_ *= 1.25;
