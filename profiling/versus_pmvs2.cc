@@ -58,12 +58,21 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// How far from one of the other cloud's points a point may be and still be
+// compared with its tangent plane: twice PMVS2's sample spacing (2 pixels).
+constexpr double kSurfaceReachGsd = 4.0;
+
 struct Row {
   std::string name;  // "PMVS2" or "sapmvs --mode M"
   ChildUsage usage;
   bool timed = true;                                 // false: a cloud of an earlier run
   PointCloud cloud;                                  // world frame
   std::optional<double> from_pmvs2[2], to_pmvs2[2];  // at 1 and 2 GSD
+  // Within 2 GSD of the other cloud's surface: of a point of it within
+  // kSurfaceReachGsd, along its normal. PMVS2 samples every second pixel, so
+  // a denser cloud's points between its samples can lie more than 2 GSD from
+  // each on the surface they sample; this tells those from points off it.
+  std::optional<double> from_pmvs2_surface, to_pmvs2_surface;
   // With truth: of PMVS2's points within 1 GSD of the true surface, the share
   // with one of ours within 2 GSD. PMVS2's points that ours miss are often
   // its wrong ones; this says how many of its right ones ours miss.
@@ -223,12 +232,13 @@ std::string Share(const std::optional<double>& v) { return v ? Fixed(100 * *v, 1
 std::string Table(const std::vector<Row>& rows, bool with_truth) {
   std::ostringstream t;
   t << "| tool / mode | wall s | CPU s | CPU/wall | matching CPU/wall | peak RSS MiB | points "
-       "| PMVS2→ours 1 GSD | PMVS2→ours 2 GSD | ours→PMVS2 1 GSD | ours→PMVS2 2 GSD |";
+       "| PMVS2→ours 1 GSD | PMVS2→ours 2 GSD | ours→PMVS2 1 GSD | ours→PMVS2 2 GSD | PMVS2→our "
+       "surface 2 GSD | ours→PMVS2's surface 2 GSD |";
   if (with_truth) {
     t << " PMVS2's right points→ours 2 GSD | within 1 GSD | median \\|dz\\| | coverage | within 2 "
          "GSD (3D) |";
   }
-  t << "\n|---|---|---|---|---|---|---|---|---|---|---|"
+  t << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     << (with_truth ? "---|---|---|---|---|" : "") << "\n";
   for (const Row& r : rows) {
     const ChildUsage& u = r.usage;
@@ -241,7 +251,8 @@ std::string Table(const std::vector<Row>& rows, bool with_truth) {
       t << "| " << r.name << " | – | – | – | – | – | ";
     }
     t << r.cloud.points.size() << " | " << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1])
-      << " | " << Share(r.to_pmvs2[0]) << " | " << Share(r.to_pmvs2[1]) << " |";
+      << " | " << Share(r.to_pmvs2[0]) << " | " << Share(r.to_pmvs2[1]) << " | "
+      << Share(r.from_pmvs2_surface) << " | " << Share(r.to_pmvs2_surface) << " |";
     if (with_truth) {
       t << " " << Share(r.right_from_pmvs2) << " |";
       if (r.truth) {
@@ -406,6 +417,17 @@ int main(int argc, char** argv) {
             r.to_pmvs2[k] = static_cast<double>(CountWithNeighbour(r.cloud, theirs, radius)) /
                             r.cloud.points.size();
           }
+        }
+        const double reach = kSurfaceReachGsd * gsd_level;
+        if (!theirs.points.empty() && r.cloud.has_normals) {
+          r.from_pmvs2_surface =
+              static_cast<double>(CountNearSurface(theirs, r.cloud, 2 * gsd_level, reach)) /
+              theirs.points.size();
+        }
+        if (!r.cloud.points.empty() && theirs.has_normals) {
+          r.to_pmvs2_surface =
+              static_cast<double>(CountNearSurface(r.cloud, theirs, 2 * gsd_level, reach)) /
+              r.cloud.points.size();
         }
       }
       if (truth) {

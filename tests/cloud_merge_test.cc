@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <random>
 
@@ -283,6 +285,54 @@ TEST(CloudMerge, NeighbourCountIsAsByBruteForce) {
   EXPECT_EQ(CountWithNeighbour(a, a, 1e-9), static_cast<long>(a.points.size()));
   EXPECT_EQ(CountWithNeighbour(a, PointCloud{}, 1.0), 0);
   EXPECT_THROW(CountWithNeighbour(a, b, 0.0), Error);
+}
+
+// A dense cloud on a plane that another samples every 3 units: every dense
+// point is on the sampled surface though few lie within the tolerance of a
+// sample; points off the plane, beyond the reach or next to samples without
+// normals are not.
+TEST(CloudMerge, SurfaceCountTakesTheSamplesTangentPlanes) {
+  const Eigen::Vector3d n = Eigen::Vector3d(0.3, -0.2, 1.0).normalized();
+  const Eigen::Vector3d u = n.cross(Eigen::Vector3d::UnitX()).normalized();
+  const Eigen::Vector3d v = n.cross(u);
+  const Eigen::Vector3d origin(500000.0, 5400000.0, 120.0);
+  PointCloud sparse, dense, off, beyond;
+  sparse.has_normals = true;
+  for (int i = 0; i < 10; ++i) {
+    for (int j = 0; j < 10; ++j) {
+      CloudPoint p;
+      p.position = origin + 3.0 * i * u + 3.0 * j * v;
+      p.normal = n.cast<float>();
+      sparse.points.push_back(p);
+    }
+  }
+  for (int i = 0; i < 54; ++i) {
+    for (int j = 0; j < 54; ++j) {
+      CloudPoint p;
+      p.position = origin + 0.5 * i * u + 0.5 * j * v;
+      dense.points.push_back(p);
+      p.position += 2.0 * n;
+      off.points.push_back(p);
+    }
+  }
+  CloudPoint far;
+  far.position = origin - 5.0 * u;  // on the plane, 5 from the nearest sample
+  beyond.points.push_back(far);
+  const long all = static_cast<long>(dense.points.size());
+  EXPECT_EQ(CountNearSurface(dense, sparse, 1.0, 4.0), all);
+  EXPECT_LT(CountWithNeighbour(dense, sparse, 1.0), all / 2);
+  EXPECT_EQ(CountNearSurface(off, sparse, 1.0, 4.0), 0);
+  EXPECT_EQ(CountNearSurface(off, sparse, 2.5, 4.0), all);
+  EXPECT_EQ(CountNearSurface(beyond, sparse, 1.0, 4.0), 0);
+  EXPECT_EQ(CountNearSurface(beyond, sparse, 1.0, 5.5), 1);
+  PointCloud no_plane = sparse;
+  for (CloudPoint& p : no_plane.points) p.normal.setZero();
+  EXPECT_EQ(CountNearSurface(dense, no_plane, 1.0, 4.0), 0);
+  no_plane.has_normals = false;
+  EXPECT_THROW(CountNearSurface(dense, no_plane, 1.0, 4.0), Error);
+  EXPECT_THROW(CountNearSurface(dense, sparse, 5.0, 4.0), Error);
+  EXPECT_THROW(CountNearSurface(dense, sparse, 0.0, 4.0), Error);
+  EXPECT_EQ(CountNearSurface(dense, PointCloud{}, 1.0, 4.0), 0);
 }
 
 }  // namespace

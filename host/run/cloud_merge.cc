@@ -304,4 +304,27 @@ long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double rad
   return with;
 }
 
+long CountNearSurface(const PointCloud& from, const PointCloud& to, double tolerance,
+                      double reach) {
+  if (!(std::isfinite(tolerance) && tolerance > 0 && std::isfinite(reach) && reach >= tolerance)) {
+    throw Error("surface count: expected 0 < tolerance <= reach");
+  }
+  if (!to.points.empty() && !to.has_normals) {
+    throw Error("surface count: the compared cloud has no normals");
+  }
+  RadiusGrid<size_t> grid(reach);
+  for (size_t i = 0; i < to.points.size(); ++i) grid.Insert(to.points[i].position, i);
+  long on = 0;
+  for (const CloudPoint& p : from.points) {
+    on += grid.AnyNear(p.position, [&](size_t j) {
+      const Eigen::Vector3d d = p.position - to.points[j].position;
+      const Eigen::Vector3d n = to.points[j].normal.cast<double>();
+      // A sample without a normal gives no plane.
+      if (!(n.squaredNorm() > 0)) return false;
+      return d.norm() <= reach && std::abs(n.normalized().dot(d)) <= tolerance;
+    });
+  }
+  return on;
+}
+
 }  // namespace sapmvs

@@ -79,4 +79,12 @@ long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group
 long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
                         std::vector<bool>* has = nullptr);
 
+// How many points of `from` lie within `tolerance` of the tangent plane
+// (position and normal) of some point of `to` that is within `reach` (3D).
+// A cloud denser than `to` has points between `to`'s samples, farther than
+// `tolerance` from each of them yet on the surface they sample; this counts
+// those as on it, and points beyond `reach` of every sample as off it.
+// `to` needs normals; 0 < tolerance <= reach.
+long CountNearSurface(const PointCloud& from, const PointCloud& to, double tolerance, double reach);
+
 }  // namespace sapmvs
