@@ -284,24 +284,39 @@ long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group
   return pairs;
 }
 
-long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
-                        std::vector<bool>* has) {
-  if (!(std::isfinite(radius) && radius > 0)) {
-    throw Error("neighbour count: expected a radius > 0");
-  }
+namespace {
+
+// How many points of `from` have a point j of `to` within `radius` for which
+// hit(point, j) holds; `has`, if given, receives the answer per point.
+template <typename Hit>
+long CountWithNear(const PointCloud& from, const PointCloud& to, double radius, const Hit& hit,
+                   std::vector<bool>* has = nullptr) {
   RadiusGrid<size_t> grid(radius);
   for (size_t i = 0; i < to.points.size(); ++i) grid.Insert(to.points[i].position, i);
   long with = 0;
   if (has) has->assign(from.points.size(), false);
   for (size_t i = 0; i < from.points.size(); ++i) {
     const CloudPoint& p = from.points[i];
-    const bool near = grid.AnyNear(p.position, [&](size_t j) {
-      return (to.points[j].position - p.position).norm() <= radius;
-    });
+    const bool near = grid.AnyNear(p.position, [&](size_t j) { return hit(p, j); });
     with += near;
     if (has) (*has)[i] = near;
   }
   return with;
+}
+
+}  // namespace
+
+long CountWithNeighbour(const PointCloud& from, const PointCloud& to, double radius,
+                        std::vector<bool>* has) {
+  if (!(std::isfinite(radius) && radius > 0)) {
+    throw Error("neighbour count: expected a radius > 0");
+  }
+  return CountWithNear(
+      from, to, radius,
+      [&](const CloudPoint& p, size_t j) {
+        return (to.points[j].position - p.position).norm() <= radius;
+      },
+      has);
 }
 
 long CountNearSurface(const PointCloud& from, const PointCloud& to, double tolerance,
@@ -312,19 +327,16 @@ long CountNearSurface(const PointCloud& from, const PointCloud& to, double toler
   if (!to.points.empty() && !to.has_normals) {
     throw Error("surface count: the compared cloud has no normals");
   }
-  RadiusGrid<size_t> grid(reach);
-  for (size_t i = 0; i < to.points.size(); ++i) grid.Insert(to.points[i].position, i);
-  long on = 0;
-  for (const CloudPoint& p : from.points) {
-    on += grid.AnyNear(p.position, [&](size_t j) {
-      const Eigen::Vector3d d = p.position - to.points[j].position;
-      const Eigen::Vector3d n = to.points[j].normal.cast<double>();
-      // A sample without a normal gives no plane.
-      if (!(n.squaredNorm() > 0)) return false;
-      return d.norm() <= reach && std::abs(n.normalized().dot(d)) <= tolerance;
-    });
+  // Unit normals once, not per pair; a sample without a normal gives no plane.
+  std::vector<Eigen::Vector3d> normals(to.points.size(), Eigen::Vector3d::Zero());
+  for (size_t j = 0; j < to.points.size(); ++j) {
+    const Eigen::Vector3d n = to.points[j].normal.cast<double>();
+    if (n.squaredNorm() > 0) normals[j] = n.normalized();
   }
-  return on;
+  return CountWithNear(from, to, reach, [&](const CloudPoint& p, size_t j) {
+    const Eigen::Vector3d d = p.position - to.points[j].position;
+    return !normals[j].isZero() && d.norm() <= reach && std::abs(normals[j].dot(d)) <= tolerance;
+  });
 }
 
 }  // namespace sapmvs
