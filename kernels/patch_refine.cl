@@ -96,7 +96,12 @@ bool improves(float score, float best) { return !isnan(score) && (isnan(best) ||
 // scoring all 6 and taking the best: a move costs 1 to 3 scores instead of
 // 6, for the same accuracy (`small`: 32 % less device time, 91.9 % of the
 // points within 1 GSD against 91.8 %; city: 39 %, 76.3 % against 75.3 %).
-// A candidate with |yaw| or |pitch| above max_angle is invalid (NaN).
+// A candidate whose normal lies more than max_angle from the reference ray
+// (cos yaw cos pitch < cos max_angle) is invalid (NaN), so the search stays
+// inside the cone the matcher accepts a patch in, as PMVS2's does (its score
+// is invalid once the reference sees the patch past its angle limit). A
+// search free to leave the cone ended outside it on surfaces seen at grazing
+// angles (Herz-Jesu-P8's forecourt), and the patch was rejected.
 __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch_refine(
     __global const float* restrict images, __global const int4* restrict image_table,
     __global const NccCamera* restrict cameras, const int num_images,
@@ -175,8 +180,9 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   }
   // Without a valid window every candidate is NaN, and the search below
   // halves its steps to the end as the reference's does.
+  const float cos_max = cos(max_angle);
   float score = NAN;
-  if (window_valid && fabs(p[1]) <= max_angle && fabs(p[2]) <= max_angle) {
+  if (window_valid && cos(p[1]) * cos(p[2]) >= cos_max) {
     score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views, win,
                             da, w, sum_w, saa, origin + p[0] * ray,
                             normal_of(e_x, e_y, e_z, p[1], p[2]), true, nccs);
@@ -191,7 +197,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
       const int k = (lead + j) % 6;
       float q[3] = {p[0], p[1], p[2]};
       q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
-      if (!(fabs(q[1]) <= max_angle && fabs(q[2]) <= max_angle)) {
+      if (!(cos(q[1]) * cos(q[2]) >= cos_max)) {
         continue;
       }
       const float s = !window_valid

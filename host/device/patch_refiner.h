@@ -15,8 +15,9 @@
 // -yaw, +pitch, -pitch, starting from the direction that moved last), moves
 // to the first candidate that strictly beats the current mean NCC, and
 // otherwise halves all steps, stopping early after max_halvings halvings. A candidate is invalid
-// (never accepted) when any view's NCC is NaN or |yaw| or |pitch| exceeds
-// max_angle_deg.
+// (never accepted) when any view's NCC is NaN or its normal lies more than
+// max_angle_deg from the direction to the reference camera
+// (cos(yaw) cos(pitch) < cos(max_angle_deg)).
 
 #include <CL/cl.h>
 

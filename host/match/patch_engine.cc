@@ -13,6 +13,9 @@
 namespace sapmvs {
 namespace {
 
+// float32 rounding of a refined normal's cosine to its reference ray.
+constexpr double kRimSlack = 1e-5;
+
 // True when image `camera` sees the plane (c, n) at most view_angle off its normal.
 bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,
            double cos_max) {
@@ -37,9 +40,17 @@ double SigmaColorOf(const MatcherOptions& options) {
   return options.mode == MatchMode::kSapmvs ? options.ncc_sigma_color : 0.0;
 }
 
+// The refinement searches only normals the reference sees within
+// view_angle_deg, as PMVS2's does: a search free to leave that cone ended
+// beyond it on ground seen at grazing angles, and the patch was rejected.
+double RefineMaxAngleOf(const MatcherOptions& options) {
+  return std::min(options.view_angle_deg, 89.0);
+}
+
 PatchRefinerOptions RefineOptionsOf(const MatcherOptions& options) {
   PatchRefinerOptions ro;
   ro.patch_size = options.window_size;
+  ro.max_angle_deg = RefineMaxAngleOf(options);
   ro.sigma_color = SigmaColorOf(options);
   return ro;
 }
@@ -57,6 +68,7 @@ std::map<int, PatchRefinerOptions> PolishOptionsOf(const MatcherOptions& options
     po.iterations = kPolishIterations;
     po.depth_step = kPolishDepthStep;
     po.angle_step_deg = kPolishAngleStepDeg;
+    po.max_angle_deg = RefineMaxAngleOf(options);
     po.sigma_color = SigmaColorOf(options);
     po.work_group_size = kPolishWorkGroupSize;
     polish[size] = po;
@@ -386,9 +398,10 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::EvaluateBatch(
     a.center = Eigen::Vector3d(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
     a.normal = Eigen::Vector3d(r.patch.normal.s[0], r.patch.normal.s[1], r.patch.normal.s[2]);
     a.ref = r.patch.reference;
-    // Refinement may turn the normal away from the images (up to the
-    // kernel's max angle); a patch seen that obliquely is not trusted.
-    if (!Faces(group_.images[a.ref].camera, a.center, a.normal, cos_max)) continue;
+    // The refinement keeps the normal within view_angle_deg of the
+    // reference, in float32: a normal on the cone's rim may read a hair
+    // outside it in double, and is kept.
+    if (!Faces(group_.images[a.ref].camera, a.center, a.normal, cos_max - kRimSlack)) continue;
     if (!OnParentPlane(candidates[refine_of[k]], a.center)) continue;
     double sum = 0;
     for (size_t v = 0; v < refine_views[k].size(); ++v) {

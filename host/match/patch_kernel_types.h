@@ -141,7 +141,8 @@ struct PatchRefinerOptions {
   double depth_step = kDefaultRefineDepthStep;
   // Initial step of yaw and pitch, in degrees; finite, > 0 and <= 45.
   double angle_step_deg = kDefaultRefineAngleStepDeg;
-  // Largest |yaw| and |pitch| a candidate may have, in degrees; (0, 89].
+  // Largest angle between a candidate's normal and the direction to the
+  // reference camera, in degrees; (0, 89].
   double max_angle_deg = kDefaultRefineMaxAngleDeg;
   // Sample weights of the NCC (NccScorerOptions::sigma_color); finite, >= 0
   // (0 = plain NCC).

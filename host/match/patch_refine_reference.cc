@@ -58,7 +58,7 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
   const double inf = std::numeric_limits<double>::infinity();
   // Single-precision step values, as the kernel receives them.
   const double angle_step = static_cast<float>(Radians(options.angle_step_deg));
-  const double max_angle = static_cast<float>(Radians(options.max_angle_deg));
+  const double cos_max = std::cos(static_cast<float>(Radians(options.max_angle_deg)));
   const double depth_step = static_cast<float>(options.depth_step);
 
   std::vector<RefinedPatchReference> results(patches.size());
@@ -71,7 +71,7 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
     // Mean NCC at (t, yaw, pitch); NaN when invalid.
     auto evaluate = [&](const double q[3], std::vector<double>* nccs) {
       nccs->assign(list.size(), nan);
-      if (!(std::abs(q[1]) <= max_angle && std::abs(q[2]) <= max_angle)) return nan;
+      if (!(std::cos(q[1]) * std::cos(q[2]) >= cos_max)) return nan;
       const Eigen::Vector3d n = f.Normal(q[1], q[2]);
       const NccPatch candidate = MakeNccPatch(f.origin + q[0] * f.ray, n, patch.reference);
       for (size_t k = 0; k < list.size(); ++k) {
@@ -107,7 +107,7 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
         double q[3] = {p[0], p[1], p[2]};
         q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
         // Out-of-range angles are skipped without a score, as in the kernel.
-        if (!(std::abs(q[1]) <= max_angle && std::abs(q[2]) <= max_angle)) continue;
+        if (!(std::cos(q[1]) * std::cos(q[2]) >= cos_max)) continue;
         const double s = evaluate(q, &trial);
         ++r.evaluations;
         // Each comparison is a decision float32 could take the other way.

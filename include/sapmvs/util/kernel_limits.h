@@ -74,8 +74,9 @@ inline constexpr int kMaxRefineIterations = 1000;
 inline constexpr double kDefaultRefineDepthStep = 1.0;
 // Initial yaw / pitch step, in degrees.
 inline constexpr double kDefaultRefineAngleStepDeg = 8.0;
-// Largest |yaw| or |pitch| (degrees from the direction to the reference
-// camera) a candidate may have: beyond it the patch is seen too obliquely.
+// Largest angle (degrees) between a candidate's normal and the direction to
+// the reference camera: beyond it the patch is seen too obliquely. The
+// matcher passes its view_angle_deg instead.
 inline constexpr double kDefaultRefineMaxAngleDeg = 80.0;
 
 // Polishing (sapmvs mode, patch_engine.h): a patch refined at the window
