@@ -24,10 +24,10 @@ constexpr bool kSanitizerAllocator = false;
 
 // Touches every page, so that the block is resident, and keeps the compiler
 // from dropping the writes.
-std::unique_ptr<char[]> TouchedBlock() {
-  std::unique_ptr<char[]> p(new char[kBlock]);
-  std::memset(p.get(), 1, kBlock);
-  volatile char sink = p[kBlock - 1];
+std::unique_ptr<char[]> TouchedBlock(size_t bytes = kBlock) {
+  std::unique_ptr<char[]> p(new char[bytes]);
+  std::memset(p.get(), 1, bytes);
+  volatile char sink = p[bytes - 1];
   (void)sink;
   return p;
 }
@@ -53,6 +53,23 @@ TEST(MemoryUse, PeakFollowsWhatIsTouchedAndResets) {
   ASSERT_TRUE(ResetPeakRss());
   EXPECT_LT(PeakRssBytes(), process_peak - 0.5 * kBlock);
   EXPECT_GE(ProcessPeakRssBytes(), process_peak);
+}
+
+TEST(MemoryUse, LargeBlocksGoBackToTheSystemWhenFreed) {
+  if (CurrentRssBytes() <= 0) GTEST_SKIP() << "this system does not report the RSS";
+  if (kSanitizerAllocator) {
+    GTEST_SKIP() << "the address sanitizer's allocator keeps freed memory in its quarantine";
+  }
+  ReturnLargeBlocksToSystem();
+  // Freeing a 24 MiB block raised glibc's own threshold to its size (it
+  // follows freed blocks up to 32 MiB), after which an 8 MiB block came from
+  // the heap and stayed resident once freed.
+  TouchedBlock(24u << 20).reset();
+  constexpr size_t kMedium = 8u << 20;
+  auto block = TouchedBlock(kMedium);
+  const double held = CurrentRssBytes();
+  block.reset();
+  EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
 }
 
 }  // namespace

@@ -12,10 +12,12 @@
 #include "cli/cli.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/log.h"
+#include "sapmvs/util/memory_use.h"
 #include "util/build_info.h"
 #include "util/gdal_messages.h"
 
 int main(int argc, char** argv) {
+  sapmvs::ReturnLargeBlocksToSystem();
   // Before anything can reach GDAL: its warnings are detail lines, its
   // failures part of our own messages.
   sapmvs::InstallGdalMessageHandler();

@@ -4,12 +4,12 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <parallel/algorithm>
 
 #include <Eigen/Eigenvalues>
 
 #include "match/footprint.h"
 #include "match/point_neighbours.h"
+#include "util/streamed_median.h"
 
 namespace sapmvs {
 namespace {
@@ -182,53 +182,50 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   stats->removed_score = low;
   std::vector<bool> keep = VisibilityFilter(group, options, points, patches, eligible);
   std::vector<int> alive;
+  alive.reserve(std::count(keep.begin(), keep.end(), true));
   for (size_t i = 0; i < points.size(); ++i) {
     if (keep[i]) alive.push_back(static_cast<int>(i));
   }
   stats->removed_visibility = static_cast<long>(points.size() - alive.size()) - low;
   if (alive.empty()) return keep;
 
-  std::vector<float> xyz(alive.size() * 3);
-  for (size_t a = 0; a < alive.size(); ++a) {
-    for (int c = 0; c < 3; ++c) xyz[3 * a + c] = static_cast<float>(points[alive[a]].x[c]);
-  }
   // Each point's footprint in its reference image, the unit of the plane
   // distances below, and its neighbour radius: neighbour_radius footprints
   // along its plane's slope, so that a surface seen obliquely, whose points
   // lie further apart, keeps as many neighbours as one seen face-on.
-  std::vector<double> footprint(alive.size()), radius(alive.size());
-#pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < alive.size(); ++a) {
-    const DensePoint& p = points[alive[a]];
-    const AcceptedPatch& patch = patches[p.patch];
-    const Camera& camera = group.images[patch.ref].camera;
-    footprint[a] = Footprint(camera, p.x);
-    radius[a] = options.neighbour_radius * SlopeFootprint(camera, p.x, patch.normal);
-  }
+  std::vector<double> footprint(alive.size());
   // nn[a * k + j]: the j-th nearest neighbour of point a within a's radius,
   // or -1.
   const int k = kNeighbours;
-  const std::vector<int32_t> nn = NearestWithin(xyz, radius, k);
-  radius = {};
-
-  // Distances, in footprints, from each patch's plane to the points of other
-  // patches among its points' neighbours (NaN for the other neighbours): the
-  // plane tolerance and test 2b below both come from them.
-  std::vector<float> foreign_distance(alive.size() * k, std::nanf(""));
+  std::vector<int32_t> nn;
+  {
+    std::vector<float> xyz(alive.size() * 3);
+    std::vector<double> radius(alive.size());
 #pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < alive.size(); ++a) {
-    const DensePoint& p = points[alive[a]];
-    const AcceptedPatch& patch = patches[p.patch];
-    const double fp = footprint[a];
-    for (int j = 0; j < k; ++j) {
-      const int32_t b = nn[a * k + j];
-      if (b < 0) continue;
-      const DensePoint& q = points[alive[b]];
-      if (q.patch == p.patch) continue;
-      foreign_distance[a * k + j] =
-          static_cast<float>(std::abs(patch.normal.dot(q.x - patch.center)) / fp);
+    for (size_t a = 0; a < alive.size(); ++a) {
+      const DensePoint& p = points[alive[a]];
+      const AcceptedPatch& patch = patches[p.patch];
+      const Camera& camera = group.images[patch.ref].camera;
+      for (int c = 0; c < 3; ++c) xyz[3 * a + c] = static_cast<float>(p.x[c]);
+      footprint[a] = Footprint(camera, p.x);
+      radius[a] = options.neighbour_radius * SlopeFootprint(camera, p.x, patch.normal);
     }
+    nn = NearestWithin(std::move(xyz), radius, k);
   }
+
+  // The distance, in footprints, from the plane of point a's patch to its
+  // j-th neighbour when that neighbour belongs to another patch, else NaN:
+  // the plane tolerance and test 2b below both come from these. Computed
+  // where needed rather than stored: kept, they were as large as `nn`.
+  auto foreign_distance = [&](size_t a, int j) {
+    const int32_t b = nn[a * k + j];
+    if (b < 0) return std::nanf("");
+    const DensePoint& p = points[alive[a]];
+    const DensePoint& q = points[alive[b]];
+    if (q.patch == p.patch) return std::nanf("");
+    const AcceptedPatch& patch = patches[p.patch];
+    return static_cast<float>(std::abs(patch.normal.dot(q.x - patch.center)) / footprint[a]);
+  };
   // The plane tolerance: at least plane_tolerance footprints, else
   // plane_sigmas robust standard deviations of those distances (1.4826 x
   // their median, as for half-normal residuals). Depth noise between patches
@@ -236,18 +233,9 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // simulator's `small`, 0.43 on NGI's scans); one fixed tolerance either lets
   // roof planes stray over the ground on the one or strips the other.
   double tolerance = options.plane_tolerance;
-  {
-    std::vector<float> d;
-    for (const float v : foreign_distance) {
-      if (!std::isnan(v)) d.push_back(v);
-    }
-    if (!d.empty()) {
-      auto mid = d.begin() + d.size() / 2;
-      // The element at mid is the same whichever way it is found.
-      __gnu_parallel::nth_element(d.begin(), mid, d.end());
-      tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * *mid);
-    }
-  }
+  const float median = StreamedMedian(
+      alive.size() * k, [&](size_t i) { return foreign_distance(i / k, static_cast<int>(i % k)); });
+  if (!std::isnan(median)) tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * median);
   stats->plane_tolerance = tolerance;
 
   // 2. Neighbourhood and local plane.
@@ -289,7 +277,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     const int id = points[alive[a]].patch;
     int f = 0, c = 0;
     for (int j = 0; j < k; ++j) {
-      const float d = foreign_distance[a * k + j];
+      const float d = foreign_distance(a, j);
       if (std::isnan(d)) continue;
       ++f;
       c += d <= tolerance;

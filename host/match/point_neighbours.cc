@@ -156,6 +156,9 @@ class ColumnGrid {
     for (size_t j = 0; j < best->size(); ++j) out[j] = (*best)[j].second;
   }
 
+  // The e-th point in column order.
+  const Entry& entry(size_t e) const { return entries_[e]; }
+
  private:
   int Cell(double x, int axis, int cells) const {
     const double c = std::floor((x - lo_[axis]) / cell_);
@@ -172,7 +175,7 @@ class ColumnGrid {
 
 }  // namespace
 
-std::vector<int32_t> NearestWithin(const std::vector<float>& xyz, const std::vector<double>& radius,
+std::vector<int32_t> NearestWithin(std::vector<float> xyz, const std::vector<double>& radius,
                                    int k) {
   const size_t n = radius.size();
   if (xyz.size() != 3 * n) {
@@ -189,22 +192,31 @@ std::vector<int32_t> NearestWithin(const std::vector<float>& xyz, const std::vec
       throw Error("NearestWithin: expected finite radii >= 0 (radius = " + std::to_string(r) + ")");
     }
   }
-  std::vector<int32_t> out(n * static_cast<size_t>(k), -1);
-  if (n == 0) return out;
+  if (n == 0) return {};
   // Half the median radius: the cells a radius reaches (about 5 x 5
   // columns) then hold a few points each.
-  std::vector<double> sorted = radius;
-  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-  const ColumnGrid grid(xyz, 0.5 * sorted[n / 2]);
-  sorted = {};
+  double median = 0;
+  {
+    std::vector<double> sorted = radius;
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+    median = sorted[n / 2];
+  }
+  const ColumnGrid grid(xyz, 0.5 * median);
+  // The grid's entries hold the coordinates from here on. The output, four
+  // times their size at k = 16, is only allocated once the input is gone:
+  // this is the peak of the filter, which is the peak of a group's run.
+  std::vector<float>().swap(xyz);  // `xyz = {}` would keep the capacity
+  std::vector<int32_t> out(n * static_cast<size_t>(k), -1);
 
 #pragma omp parallel
   {
     std::vector<std::pair<float, int32_t>> best;
     best.reserve(k);
+    // In the grid's order, so that consecutive queries read the same columns.
 #pragma omp for schedule(dynamic, 512)
-    for (size_t a = 0; a < n; ++a) {
-      const float* q = &xyz[3 * a];
+    for (size_t e = 0; e < n; ++e) {
+      const float q[3] = {grid.entry(e).x, grid.entry(e).y, grid.entry(e).z};
+      const size_t a = static_cast<size_t>(grid.entry(e).index);
       // Padded, so that a point whose float distance rounds to within the
       // radius is never in a cell beyond the box.
       const double reach =

@@ -21,8 +21,9 @@ namespace sapmvs {
 // z order, is at most float(radius[a]^2), nearest first (ties by index);
 // row a is out[a * k .. a * k + k), padded with -1. Throws Error when the
 // sizes disagree, k < 1, a radius is negative or not finite, or there are
-// more than 2^31 - 1 points.
-std::vector<int32_t> NearestWithin(const std::vector<float>& xyz, const std::vector<double>& radius,
+// more than 2^31 - 1 points. `xyz` is taken by value so that a caller that
+// moves it in frees it before the output is allocated.
+std::vector<int32_t> NearestWithin(std::vector<float> xyz, const std::vector<double>& radius,
                                    int k);
 
 }  // namespace sapmvs

@@ -79,7 +79,7 @@ GeoRaster StreamedDsm::Finish(int fill_passes) {
       band.file.reset();
     }
     heights.insert(heights.end(), band.buffer.begin(), band.buffer.end());
-    band.buffer = {};
+    std::vector<Height>().swap(band.buffer);  // `= {}` would keep its capacity
     // By cell; a cell's median does not depend on the order of its heights.
     std::sort(heights.begin(), heights.end(),
               [](const Height& a, const Height& b) { return a.cell < b.cell; });

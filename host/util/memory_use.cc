@@ -53,6 +53,12 @@ bool ResetPeakRss() {
   return static_cast<bool>(f);
 }
 
+void ReturnLargeBlocksToSystem() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 2 << 20);
+#endif
+}
+
 void ReleaseFreeMemory() {
 #if defined(__GLIBC__)
   malloc_trim(0);
