@@ -9,7 +9,9 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "sapmvs/util/error.h"
 
@@ -41,6 +43,27 @@ std::string ChildUsage::Describe() const {
   return "exit " + std::to_string(exit_code);
 }
 
+namespace {
+
+// (steal, total) jiffies of all CPUs from /proc/stat's first line; (0, 0)
+// where it cannot be read.
+std::pair<double, double> StealAndTotalJiffies() {
+  std::ifstream f("/proc/stat");
+  std::string cpu;
+  f >> cpu;
+  if (cpu != "cpu") return {0, 0};
+  // user nice system idle iowait irq softirq steal (guest times are already
+  // in user and nice).
+  double field[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (double& v : field) f >> v;
+  if (!f) return {0, 0};
+  double total = 0;
+  for (const double v : field) total += v;
+  return {field[7], total};
+}
+
+}  // namespace
+
 ChildUsage RunTimed(const ChildCommand& command) {
   if (command.argv.empty()) throw Error("run: empty command");
   int log_fd = -1;
@@ -55,6 +78,7 @@ ChildUsage RunTimed(const ChildCommand& command) {
   // means the exec succeeded.
   int report[2];
   if (pipe2(report, O_CLOEXEC) != 0) throw Error(std::string("pipe: ") + strerror(errno));
+  const auto [steal_before, total_before] = StealAndTotalJiffies();
   const auto start = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid < 0) throw Error(std::string("fork: ") + strerror(errno));
@@ -86,6 +110,10 @@ ChildUsage RunTimed(const ChildCommand& command) {
   const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
   u.cpu_seconds = seconds(usage.ru_utime) + seconds(usage.ru_stime);
   u.peak_rss_mib = usage.ru_maxrss / 1024.0;  // Linux reports KiB
+  const auto [steal_after, total_after] = StealAndTotalJiffies();
+  if (total_before > 0 && total_after > total_before) {
+    u.host_steal = (steal_after - steal_before) / (total_after - total_before);
+  }
   if (WIFEXITED(status)) u.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) u.signal = WTERMSIG(status);
   return u;

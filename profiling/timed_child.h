@@ -25,6 +25,11 @@ struct ChildUsage {
   double wall_seconds = 0;
   double cpu_seconds = 0;   // user + system, all its threads and waited-for children
   double peak_rss_mib = 0;  // ru_maxrss
+  // Share of the machine's CPU time that its hypervisor gave to other guests
+  // while the command ran ("steal" in /proc/stat, all CPUs); -1 where the
+  // system does not say. A shared virtual machine's CPU/wall falls with it
+  // whatever the program does, so the tables show it beside CPU/wall.
+  double host_steal = -1;
   bool Ok() const { return signal == 0 && exit_code == 0; }
   // "exit 3" or "signal 9 (Killed)".
   std::string Describe() const;

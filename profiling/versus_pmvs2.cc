@@ -231,24 +231,26 @@ std::string Share(const std::optional<double>& v) { return v ? Fixed(100 * *v, 1
 
 std::string Table(const std::vector<Row>& rows, bool with_truth) {
   std::ostringstream t;
-  t << "| tool / mode | wall s | CPU s | CPU/wall | matching CPU/wall | peak RSS MiB | points "
+  t << "| tool / mode | wall s | CPU s | CPU/wall | matching CPU/wall | host steal | peak RSS MiB "
+       "| points "
        "| PMVS2→ours 1 GSD | PMVS2→ours 2 GSD | ours→PMVS2 1 GSD | ours→PMVS2 2 GSD | PMVS2→our "
        "surface 2 GSD | ours→PMVS2's surface 2 GSD |";
   if (with_truth) {
     t << " PMVS2's right points→ours 2 GSD | within 1 GSD | median \\|dz\\| | coverage | within 2 "
          "GSD (3D) |";
   }
-  t << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  t << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     << (with_truth ? "---|---|---|---|---|" : "") << "\n";
   for (const Row& r : rows) {
     const ChildUsage& u = r.usage;
     if (r.timed) {
       t << "| " << r.name << " | " << Fixed(u.wall_seconds, 1) << " | " << Fixed(u.cpu_seconds, 1)
         << " | " << Fixed(u.cpu_seconds / std::max(u.wall_seconds, 1e-9), 2) << " | "
-        << (r.matching_busy ? Fixed(*r.matching_busy, 2) : "–") << " | " << Fixed(u.peak_rss_mib, 0)
-        << " | ";
+        << (r.matching_busy ? Fixed(*r.matching_busy, 2) : "–") << " | "
+        << (u.host_steal >= 0 ? Fixed(100 * u.host_steal, 0) + " %" : "–") << " | "
+        << Fixed(u.peak_rss_mib, 0) << " | ";
     } else {
-      t << "| " << r.name << " | – | – | – | – | – | ";
+      t << "| " << r.name << " | – | – | – | – | – | – | ";
     }
     t << r.cloud.points.size() << " | " << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1])
       << " | " << Share(r.to_pmvs2[0]) << " | " << Share(r.to_pmvs2[1]) << " | "
