@@ -41,7 +41,10 @@ struct MatcherOptions {
   // forward overlap every neighbour of an image is (4 degrees apart).
   double max_angle_deg = 10.0;
   // Largest angle, degrees, between a patch normal and the direction to an
-  // image for that image to be a visible view of the patch.
+  // image for that image to be a visible view of the patch. The refinement
+  // searches normals within this angle of the reference ray, at most 89
+  // degrees (PatchRefinerOptions::max_angle_deg's limit), so values between 89
+  // and 90 refine as 89.
   double view_angle_deg = 60.0;
   // Side of the matching window (PMVS2's `wsize`), pixels, odd: the patch
   // refined by the device, and the smallest adaptive patch.
