@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -12,6 +13,7 @@
 
 #include "cl_test_fixture.h"
 #include "device/cl_patch_kernels.h"
+#include "device/ncc_scorer.h"
 #include "match/edge_matcher.h"
 #include "match/group_data.h"
 #include "match/patch_engine.h"
@@ -287,6 +289,30 @@ TEST_F(MatchGroupTest, PmvsModeMatchesTheTrueSurface) {
   for (const auto& [size, count] : s.accepted_by_size) EXPECT_EQ(size, o.window_size);
   ExpectMeetsFloors(m, {8000, 0.9, 0.4, 0.63});
   ExpectPointsWellFormed(m.result.cloud, o);
+}
+
+// The group's grey images lie in one page-aligned block, one after the
+// other with their rows packed, where the kernels' image buffer puts them;
+// PoCL's CPU device reads that block in place instead of a copy.
+TEST_F(MatchGroupTest, GreyImagesArePackedInOneBlockTheDeviceReadsInPlace) {
+  const Block block = ReadBlock(TinyDir() / "block.yaml");
+  const MatchGroupData group = LoadMatchGroup(block, {0, 1, 2, 3}, 1, nullptr);
+  ASSERT_NE(group.ncc.pixels, nullptr);
+  EXPECT_EQ(reinterpret_cast<uintptr_t>(group.ncc.pixels.get()) % 4096, 0u);
+  size_t offset = 0;
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    const cv::Mat& grey = group.images[i].grey;
+    ASSERT_EQ(grey.type(), CV_32F);
+    EXPECT_TRUE(grey.isContinuous());
+    EXPECT_EQ(grey.ptr<float>(), group.ncc.pixels.get() + offset) << "image " << i;
+    EXPECT_EQ(group.ncc.images[i].data, grey.ptr<float>()) << "image " << i;
+    offset += grey.total();
+  }
+  const NccDeviceGroup device = UploadNccGroup(context(), group.ncc);
+  if (!context().device().host_unified_memory) {
+    GTEST_SKIP() << context().device().name << " has memory of its own: the images are copied";
+  }
+  EXPECT_EQ(device.pixels.get(), group.ncc.pixels.get());
 }
 
 // The paper's edge barriers (--edges, off by default): the edges matched

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
@@ -178,6 +179,59 @@ INSTANTIATE_TEST_SUITE_P(NccSizes, NccScorerCaseTest,
                          CaseName);
 
 class NccScorerTest : public ClTest {};
+
+// A group whose images lie in one host block at the buffer's offsets (as
+// LoadMatchGroup packs them): a device sharing the host's memory reads the
+// block in place, and scores exactly as from a copy; a group whose images
+// do not lie so is copied.
+TEST_F(NccScorerTest, ImagesInOneHostBlockAreReadInPlaceAndScoreAsACopy) {
+  const PlaneScene scene = MakePlaneScene(3, 97, 61, 52);
+  size_t total = 0;
+  for (const FloatImageView& v : scene.group.images) total += v.layout.RequiredElements();
+  std::shared_ptr<float> block(new float[total], std::default_delete<float[]>());
+  NccGroup packed = scene.group;
+  size_t offset = 0;
+  for (FloatImageView& v : packed.images) {
+    std::copy(v.data, v.data + v.layout.RequiredElements(), block.get() + offset);
+    v.data = block.get() + offset;
+    offset += v.layout.RequiredElements();
+  }
+  packed.pixels = block;
+  const NccDeviceGroup device = UploadNccGroup(context(), packed);
+  if (context().device().host_unified_memory) {
+    EXPECT_EQ(device.pixels.get(), block.get());
+    void* host = nullptr;
+    ASSERT_EQ(clGetMemObjectInfo(device.images.get(), CL_MEM_HOST_PTR, sizeof host, &host, nullptr),
+              CL_SUCCESS);
+    EXPECT_EQ(host, static_cast<void*>(block.get()));
+  } else {
+    EXPECT_EQ(device.pixels, nullptr) << "a device with memory of its own gets a copy";
+  }
+  // One image elsewhere: copied, whatever the device.
+  NccGroup scattered = packed;
+  scattered.images[1].data = scene.group.images[1].data;
+  EXPECT_EQ(UploadNccGroup(context(), scattered).pixels, nullptr);
+
+  std::vector<NccPatch> patches;
+  std::vector<NccPair> pairs;
+  RandomBatch(scene, 120, 53, &patches, &pairs);
+  NccScorer copied(context()), in_place(context());
+  copied.SetGroup(scene.group);
+  in_place.SetGroup(packed);
+  const std::vector<float> a = copied.Score(patches, pairs);
+  const std::vector<float> b = in_place.Score(patches, pairs);
+  ASSERT_EQ(a.size(), b.size());
+  int valid = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (std::isnan(a[i])) {
+      EXPECT_TRUE(std::isnan(b[i])) << "pair " << i;
+    } else {
+      EXPECT_EQ(a[i], b[i]) << "pair " << i;
+      ++valid;
+    }
+  }
+  EXPECT_GT(valid, static_cast<int>(a.size()) / 4);
+}
 
 // The geometry check: the true patch is photo-consistent in every view, the
 // same patch slid along the reference ray is not.

@@ -87,6 +87,7 @@ DeviceInfo QueryDevice(cl_platform_id platform, int platform_index, cl_device_id
   CL_CHECK(clGetDeviceInfo(id, CL_DEVICE_MAX_WORK_ITEM_SIZES, dims * sizeof(size_t),
                            info.max_work_item_sizes.data(), nullptr));
   info.image_support = DeviceValue<cl_bool>(id, CL_DEVICE_IMAGE_SUPPORT) != CL_FALSE;
+  info.host_unified_memory = DeviceValue<cl_bool>(id, CL_DEVICE_HOST_UNIFIED_MEMORY) != CL_FALSE;
   info.version = DeviceString(id, CL_DEVICE_VERSION);
   info.opencl_c_version = DeviceString(id, CL_DEVICE_OPENCL_C_VERSION);
   return info;
@@ -298,7 +299,18 @@ double DeviceBytesInUse() { return static_cast<double>(device_bytes_in_use.load(
 double PeakDeviceBytes() { return static_cast<double>(device_bytes_peak.load()); }
 void ResetPeakDeviceBytes() { device_bytes_peak = device_bytes_in_use.load(); }
 
-ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags) : size_(bytes) {
+ClBuffer ClBuffer::ReadOnlyInPlace(const ClContext& context, const void* host, size_t bytes) {
+  if (host == nullptr) throw Error("cannot create an OpenCL buffer over no host memory");
+  // OpenCL's signature is not const; CL_MEM_READ_ONLY keeps kernels from
+  // writing to it.
+  return ClBuffer(context, bytes, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, const_cast<void*>(host));
+}
+
+ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags)
+    : ClBuffer(context, bytes, flags, nullptr) {}
+
+ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags, void* host)
+    : size_(bytes) {
   if (bytes == 0) throw Error("cannot create an empty OpenCL buffer (0 bytes)");
   if (bytes > context.device().max_alloc_bytes) {
     throw Error("OpenCL buffer of " + std::to_string(bytes) + " bytes exceeds " +
@@ -306,8 +318,7 @@ ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags) :
                 std::to_string(context.device().max_alloc_bytes) + " bytes");
   }
   cl_int status = CL_SUCCESS;
-  mem_ =
-      internal::ClHandle<cl_mem>(clCreateBuffer(context.context(), flags, bytes, nullptr, &status));
+  mem_ = internal::ClHandle<cl_mem>(clCreateBuffer(context.context(), flags, bytes, host, &status));
   if (status != CL_SUCCESS) {
     throw ClError(status, "clCreateBuffer", __FILE__, __LINE__, std::to_string(bytes) + " bytes");
   }

@@ -53,6 +53,10 @@ struct DeviceInfo {
   size_t max_work_group_size = 0;           // CL_DEVICE_MAX_WORK_GROUP_SIZE, work-items.
   std::vector<size_t> max_work_item_sizes;  // Per dimension, work-items.
   bool image_support = false;
+  // CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads the host's memory as its
+  // own (CPU devices, integrated GPUs), so a buffer can use host memory in
+  // place rather than hold a copy of it.
+  bool host_unified_memory = false;
   std::string version;           // CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ...".
   std::string opencl_c_version;  // CL_DEVICE_OPENCL_C_VERSION, e.g. "OpenCL C 1.2 PoCL".
   cl_platform_id platform_id = nullptr;
@@ -214,6 +218,10 @@ class ClBuffer {
   ClBuffer() = default;
   // Throws Error for 0 bytes or more than the device's max allocation.
   ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE);
+  // A read-only buffer over `bytes` of host memory at `host`
+  // (CL_MEM_USE_HOST_PTR), which must outlive it and stay unchanged: on a
+  // device with host_unified_memory the kernels read it in place.
+  static ClBuffer ReadOnlyInPlace(const ClContext& context, const void* host, size_t bytes);
 
   cl_mem get() const { return mem_.get(); }
   size_t size() const { return size_; }  // Bytes.
@@ -238,6 +246,7 @@ class ClBuffer {
   }
 
  private:
+  ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags, void* host);
   void CheckRange(const char* what, size_t bytes, size_t offset) const;
 
   internal::ClHandle<cl_mem> mem_;

@@ -63,10 +63,22 @@ NccDeviceGroup UploadNccGroup(ClContext& context, const NccGroup& group) {
     table[i].s[3] = layout.row_pitch;
     total += layout.RequiredElements();
   }
-  ClBuffer images(context, total * sizeof(float), CL_MEM_READ_ONLY);
-  for (size_t i = 0; i < group.images.size(); ++i) {
-    images.Write(group.images[i].data, group.images[i].layout.RequiredElements() * sizeof(float),
-                 static_cast<size_t>(table[i].s[0]) * sizeof(float));
+  // In place: the block holds the images at the table's offsets, and the
+  // device reads host memory as its own. Its alignment is left to the
+  // implementation, which copies where it must.
+  bool in_place = group.pixels != nullptr && context.device().host_unified_memory;
+  for (size_t i = 0; in_place && i < group.images.size(); ++i) {
+    in_place = group.images[i].data == group.pixels.get() + table[i].s[0];
+  }
+  ClBuffer images;
+  if (in_place) {
+    images = ClBuffer::ReadOnlyInPlace(context, group.pixels.get(), total * sizeof(float));
+  } else {
+    images = ClBuffer(context, total * sizeof(float), CL_MEM_READ_ONLY);
+    for (size_t i = 0; i < group.images.size(); ++i) {
+      images.Write(group.images[i].data, group.images[i].layout.RequiredElements() * sizeof(float),
+                   static_cast<size_t>(table[i].s[0]) * sizeof(float));
+    }
   }
   ClBuffer image_table(context, table.size() * sizeof(cl_int4), CL_MEM_READ_ONLY);
   image_table.WriteVector(table);
@@ -77,6 +89,7 @@ NccDeviceGroup UploadNccGroup(ClContext& context, const NccGroup& group) {
   out.image_table = std::move(image_table);
   out.cameras = std::move(cameras);
   out.num_images = static_cast<int>(group.images.size());
+  if (in_place) out.pixels = group.pixels;
   return out;
 }
 

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 
 #include "sapmvs/block/block_geometry.h"
@@ -38,6 +41,7 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
   }
   const double scale = std::ldexp(1.0, -level);
   std::vector<double> gsds;
+  std::vector<cv::Mat> grey8(ids.size());
   for (const int id : ids) {
     const BlockImage& bi = block.images.at(id);
     LoadedImage loaded = LoadUndistorted(bi);
@@ -48,9 +52,7 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     const cv::Mat bgr =
         ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
     im.color = bgr;
-    cv::Mat grey8;
-    cv::cvtColor(bgr, grey8, cv::COLOR_BGR2GRAY);
-    grey8.convertTo(im.grey, CV_32F);
+    cv::cvtColor(bgr, grey8[group.images.size()], cv::COLOR_BGR2GRAY);
     const bool have = geometry.images.size() > static_cast<size_t>(id) && geometry.images[id].valid;
     im.depth = have ? geometry.images[id].depth : fallback_depth;
     if (im.depth > 0) gsds.push_back(im.depth / im.camera.intrinsics().MeanFocal());
@@ -62,6 +64,34 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     std::nth_element(gsds.begin(), gsds.begin() + gsds.size() / 2, gsds.end());
     group.gsd = gsds[gsds.size() / 2];
   }
+  // Every grey image in one block, rows packed, in the order and at the
+  // offsets of the kernels' image buffer (UploadNccGroup), so that a device
+  // sharing the host's memory reads them in place. group.ncc.pixels owns it
+  // (MatchImage::grey); it starts on a page boundary, which any device's
+  // base address alignment divides.
+  constexpr size_t kAlignFloats = 4096 / sizeof(float);
+  size_t total = 0;
+  for (const cv::Mat& g : grey8) total += g.total();
+  if (total + kAlignFloats > static_cast<size_t>(std::numeric_limits<int>::max())) {
+    throw Error("the group's images hold " + std::to_string(total) +
+                " pixels, more than one image block can (2^31 - 1)");
+  }
+  cv::Mat pixels(1, static_cast<int>(total + kAlignFloats), CV_32F);
+  const size_t misalign = reinterpret_cast<uintptr_t>(pixels.data) % 4096 / sizeof(float);
+  size_t offset = misalign == 0 ? 0 : kAlignFloats - misalign;
+  const float* first = pixels.ptr<float>() + offset;
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    const int n = static_cast<int>(grey8[i].total());
+    // A header over the block, not a region of it: OpenCV's filters read
+    // past a region's edges into its parent (the images beside it) instead
+    // of extrapolating the border.
+    cv::Mat in_block(grey8[i].rows, grey8[i].cols, CV_32F, pixels.ptr<float>() + offset);
+    grey8[i].convertTo(in_block, CV_32F);
+    group.images[i].grey = in_block;
+    offset += n;
+    grey8[i].release();
+  }
+  group.ncc.pixels = std::shared_ptr<const float>(first, [pixels](const float*) {});
   for (const MatchImage& im : group.images) {
     FloatImageView view;
     view.data = im.grey.ptr<float>();

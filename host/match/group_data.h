@@ -19,8 +19,10 @@ struct MatcherOptions;
 struct MatchImage {
   std::string name;
   int block_index = -1;
-  Camera camera;           // local frame, working level, no distortion
-  cv::Mat grey;            // CV_32F, grey levels 0..255
+  Camera camera;  // local frame, working level, no distortion
+  // CV_32F, grey levels 0..255; a view into the group's one block of pixels,
+  // which MatchGroupData::ncc.pixels owns (LoadMatchGroup).
+  cv::Mat grey;
   cv::Mat color;           // CV_8UC3, BGR
   std::vector<int> views;  // other images of the group to match with, best first
   double depth = 0;        // expected scene depth along the optical axis

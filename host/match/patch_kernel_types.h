@@ -22,6 +22,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,12 @@ NccPatch MakeNccPatch(const Eigen::Vector3d& center, const Eigen::Vector3d& norm
 struct NccGroup {
   std::vector<FloatImageView> images;
   std::vector<NccCamera> cameras;  // cameras[i] belongs to images[i].
+  // Optional: one allocation that holds every image, one after the other
+  // with their rows packed, as the kernels' single image buffer lays them
+  // out (LoadMatchGroup's group). A device that shares the host's memory
+  // (PoCL's CPU device) then reads the images where they are instead of a
+  // copy of them all, and keeps this block alive as long as it does.
+  std::shared_ptr<const float> pixels;
 
   // Throws Error naming the image at fault: a bad layout, no data, a count
   // mismatch, a non-finite camera or a focal length <= 0.
