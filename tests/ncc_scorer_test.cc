@@ -197,15 +197,20 @@ TEST_F(NccScorerTest, ImagesInOneHostBlockAreReadInPlaceAndScoreAsACopy) {
     offset += v.layout.RequiredElements();
   }
   packed.pixels = block;
+  const double device_before = DeviceBytesInUse();
   const NccDeviceGroup device = UploadNccGroup(context(), packed);
+  const double image_bytes = static_cast<double>(total * sizeof(float));
   if (context().device().host_unified_memory) {
     EXPECT_EQ(device.pixels.get(), block.get());
+    EXPECT_LT(DeviceBytesInUse() - device_before, image_bytes)
+        << "the images read in place are not device memory of its own";
     void* host = nullptr;
     ASSERT_EQ(clGetMemObjectInfo(device.images.get(), CL_MEM_HOST_PTR, sizeof host, &host, nullptr),
               CL_SUCCESS);
     EXPECT_EQ(host, static_cast<void*>(block.get()));
   } else {
     EXPECT_EQ(device.pixels, nullptr) << "a device with memory of its own gets a copy";
+    EXPECT_GE(DeviceBytesInUse() - device_before, image_bytes);
   }
   // One image elsewhere: copied, whatever the device.
   NccGroup scattered = packed;

@@ -324,7 +324,10 @@ ClBuffer::ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags, v
   }
   CL_CHECK(clRetainCommandQueue(context.queue()));
   queue_ = internal::ClHandle<cl_command_queue>(context.queue());
-  count_ = internal::DeviceBytesCount(bytes);
+  // Over host memory on a device that shares it, the kernels read the
+  // caller's bytes: nothing is held apart from the process's own memory.
+  const bool shared = (flags & CL_MEM_USE_HOST_PTR) && context.device().host_unified_memory;
+  if (!shared) count_ = internal::DeviceBytesCount(bytes);
 }
 
 void ClBuffer::CheckRange(const char* what, size_t bytes, size_t offset) const {

@@ -220,7 +220,8 @@ class ClBuffer {
   ClBuffer(const ClContext& context, size_t bytes, cl_mem_flags flags = CL_MEM_READ_WRITE);
   // A read-only buffer over `bytes` of host memory at `host`
   // (CL_MEM_USE_HOST_PTR), which must outlive it and stay unchanged: on a
-  // device with host_unified_memory the kernels read it in place.
+  // device with host_unified_memory the kernels read it in place, and it is
+  // not counted in DeviceBytesInUse.
   static ClBuffer ReadOnlyInPlace(const ClContext& context, const void* host, size_t bytes);
 
   cl_mem get() const { return mem_.get(); }

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
+#include <cstdlib>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 
@@ -69,29 +69,31 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
   // sharing the host's memory reads them in place. group.ncc.pixels owns it
   // (MatchImage::grey); it starts on a page boundary, which any device's
   // base address alignment divides.
-  constexpr size_t kAlignFloats = 4096 / sizeof(float);
+  constexpr size_t kPage = 4096;
   size_t total = 0;
   for (const cv::Mat& g : grey8) total += g.total();
-  if (total + kAlignFloats > static_cast<size_t>(std::numeric_limits<int>::max())) {
-    throw Error("the group's images hold " + std::to_string(total) +
-                " pixels, more than one image block can (2^31 - 1)");
+  // Not a cv::Mat: its int columns would cap a group at 2^31 pixels, which
+  // only the OpenCL devices' int offsets need to (UploadNccGroup says so).
+  const size_t bytes = (total * sizeof(float) + kPage - 1) / kPage * kPage;
+  float* block_start = static_cast<float*>(std::aligned_alloc(kPage, bytes));
+  if (block_start == nullptr) {
+    throw Error("cannot allocate " + std::to_string(bytes) + " bytes for the group's " +
+                std::to_string(group.images.size()) + " grey images");
   }
-  cv::Mat pixels(1, static_cast<int>(total + kAlignFloats), CV_32F);
-  const size_t misalign = reinterpret_cast<uintptr_t>(pixels.data) % 4096 / sizeof(float);
-  size_t offset = misalign == 0 ? 0 : kAlignFloats - misalign;
-  const float* first = pixels.ptr<float>() + offset;
+  group.ncc.pixels = std::shared_ptr<const float>(
+      block_start, [](const float* p) { std::free(const_cast<float*>(p)); });
+  size_t offset = 0;
   for (size_t i = 0; i < group.images.size(); ++i) {
-    const int n = static_cast<int>(grey8[i].total());
     // A header over the block, not a region of it: OpenCV's filters read
     // past a region's edges into its parent (the images beside it) instead
-    // of extrapolating the border.
-    cv::Mat in_block(grey8[i].rows, grey8[i].cols, CV_32F, pixels.ptr<float>() + offset);
+    // of extrapolating the border. MatchImage::grey shares the block's
+    // lifetime through group.ncc.pixels.
+    cv::Mat in_block(grey8[i].rows, grey8[i].cols, CV_32F, block_start + offset);
     grey8[i].convertTo(in_block, CV_32F);
     group.images[i].grey = in_block;
-    offset += n;
+    offset += grey8[i].total();
     grey8[i].release();
   }
-  group.ncc.pixels = std::shared_ptr<const float>(first, [pixels](const float*) {});
   for (const MatchImage& im : group.images) {
     FloatImageView view;
     view.data = im.grey.ptr<float>();
