@@ -97,6 +97,41 @@ TEST_F(PlyIoTest, BinaryRoundTripKeepsEveryFieldAndTheCrs) {
   ExpectSamePoints(cloud, back);
 }
 
+// A filtered read keeps the points the filter accepts, in file order, with
+// the file's flags and CRS, and shows the filter every point once, binary
+// and ascii alike.
+TEST_F(PlyIoTest, FilteredReadKeepsTheAcceptedPointsInOrder) {
+  PointCloud cloud = RandomCloud(777, 11);
+  cloud.crs = "EPSG:32632";
+  const fs::path path = dir_ / "cloud.ply";
+  WritePly(path, cloud);
+  auto west = [](const CloudPoint& p) { return p.position.x() < 5e5; };
+  PointCloud expected = cloud;
+  expected.points.clear();
+  std::copy_if(cloud.points.begin(), cloud.points.end(), std::back_inserter(expected.points), west);
+  ASSERT_GT(expected.points.size(), 100u);
+  ASSERT_LT(expected.points.size(), cloud.points.size() - 100);
+  long shown = 0;
+  const PointCloud back = ReadPly(path, [&](const CloudPoint& p) {
+    ++shown;
+    return west(p);
+  });
+  EXPECT_EQ(shown, 777);
+  EXPECT_EQ(back.crs, "EPSG:32632");
+  EXPECT_TRUE(back.has_normals && back.has_colors && back.has_scores && back.has_views);
+  ExpectSamePoints(expected, back);
+
+  const fs::path ascii = dir_ / "hand.ply";
+  WriteText(ascii,
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n-1 0 0\n6e5 0 0\n-3 0 0\n7e5 0 0\n");
+  const PointCloud a = ReadPly(ascii, west);
+  ASSERT_EQ(a.points.size(), 2u);
+  EXPECT_EQ(a.points[0].position.x(), -1);
+  EXPECT_EQ(a.points[1].position.x(), -3);
+  EXPECT_EQ(ReadPly(ascii, PointFilter()).points.size(), 4u);
+}
+
 TEST_F(PlyIoTest, WrittenBytesFollowTheSpecification) {
   PointCloud cloud = RandomCloud(3, 11);
   cloud.has_normals = cloud.has_scores = false;

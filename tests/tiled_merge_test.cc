@@ -68,7 +68,17 @@ Block MakeBlock() {
 std::vector<MergeSource> Sources(const Block& b) {
   std::vector<MergeSource> s;
   for (size_t g = 0; g < b.clouds.size(); ++g) {
-    s.push_back({[&b, g] { return b.clouds[g]; }, b.centers[g]});
+    s.push_back({[&b, g](const PointFilter& keep) {
+                   PointCloud c = b.clouds[g];
+                   if (keep) {
+                     auto& p = c.points;
+                     p.erase(std::remove_if(p.begin(), p.end(),
+                                            [&](const CloudPoint& q) { return !keep(q); }),
+                             p.end());
+                   }
+                   return c;
+                 },
+                 b.centers[g]});
   }
   return s;
 }

@@ -350,7 +350,7 @@ std::string Ordinal(uint64_t i, const PlyElement& e) {
 }
 
 void ReadBinaryElement(BinaryCursor* in, const std::string& file, const PlyElement& e, bool swap,
-                       std::vector<CloudPoint>* points) {
+                       std::vector<CloudPoint>* points, const PointFilter& keep) {
   for (uint64_t i = 0; i < e.count; ++i) {
     CloudPoint p;
     for (const PlyProperty& prop : e.properties) {
@@ -380,7 +380,7 @@ void ReadBinaryElement(BinaryCursor* in, const std::string& file, const PlyEleme
       if (!p.position.allFinite()) {
         throw InputError(file, 0, "non-finite coordinate in " + Ordinal(i, e));
       }
-      points->push_back(p);
+      if (!keep || keep(p)) points->push_back(p);
     }
   }
 }
@@ -394,7 +394,8 @@ double ParseAscii(const std::string& token, const TextLines& lines, const PlyPro
   return v;
 }
 
-void ReadAsciiElement(TextLines* lines, const PlyElement& e, std::vector<CloudPoint>* points) {
+void ReadAsciiElement(TextLines* lines, const PlyElement& e, std::vector<CloudPoint>* points,
+                      const PointFilter& keep) {
   std::string line;
   for (uint64_t i = 0; i < e.count; ++i) {
     do {
@@ -433,7 +434,7 @@ void ReadAsciiElement(TextLines* lines, const PlyElement& e, std::vector<CloudPo
       if (!p.position.allFinite()) {
         throw lines->Fail("non-finite coordinate in " + Ordinal(i, e));
       }
-      points->push_back(p);
+      if (!keep || keep(p)) points->push_back(p);
     }
   }
 }
@@ -445,7 +446,9 @@ bool Declares(const PlyElement& e, Role role) {
 
 }  // namespace
 
-PointCloud ReadPly(const std::filesystem::path& path) {
+PointCloud ReadPly(const std::filesystem::path& path) { return ReadPly(path, PointFilter()); }
+
+PointCloud ReadPly(const std::filesystem::path& path, const PointFilter& keep) {
   const std::string file = path.string();
   if (const std::string problem = NotRegularFile(path); !problem.empty()) {
     throw InputError(file, 0, "cannot open file (" + problem + "; expected a PLY file)");
@@ -471,8 +474,8 @@ PointCloud ReadPly(const std::filesystem::path& path) {
   cloud.has_scores = Declares(*vertex, Role::kScore);
   cloud.has_views = Declares(*vertex, Role::kViews);
   // Cap the reservation: a corrupt count must not allocate before the data
-  // proves it exists.
-  cloud.points.reserve(static_cast<size_t>(std::min<uint64_t>(vertex->count, 1u << 24)));
+  // proves it exists. A filtered read keeps an unknown share.
+  if (!keep) cloud.points.reserve(static_cast<size_t>(std::min<uint64_t>(vertex->count, 1u << 24)));
 
   if (h.format == PlyFormat::kAscii) {
     in.close();
@@ -480,7 +483,7 @@ PointCloud ReadPly(const std::filesystem::path& path) {
     std::string skip;
     for (int i = 0; i < h.lines; ++i) lines.NextRaw(&skip, false);
     for (auto e = h.elements.begin(); e != std::next(vertex); ++e) {
-      ReadAsciiElement(&lines, *e, e == vertex ? &cloud.points : nullptr);
+      ReadAsciiElement(&lines, *e, e == vertex ? &cloud.points : nullptr, keep);
     }
     return cloud;
   }
@@ -488,7 +491,7 @@ PointCloud ReadPly(const std::filesystem::path& path) {
   const bool swap = h.format == PlyFormat::kBinaryBigEndian;
   BinaryCursor cursor(in);
   for (auto e = h.elements.begin(); e != std::next(vertex); ++e) {
-    ReadBinaryElement(&cursor, file, *e, swap, e == vertex ? &cloud.points : nullptr);
+    ReadBinaryElement(&cursor, file, *e, swap, e == vertex ? &cloud.points : nullptr, keep);
   }
   return cloud;
 }

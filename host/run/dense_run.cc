@@ -254,7 +254,9 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   // Merge from the checkpoints, fresh or resumed alike, tile by tile.
   MergedOutputsJob job;
   for (int g = 0; g < n; ++g) {
-    job.groups.push_back({[&checkpoints, g] { return ReadPly(checkpoints.CloudPath(g)); },
+    job.groups.push_back({[&checkpoints, g](const PointFilter& keep) {
+                            return ReadPly(checkpoints.CloudPath(g), keep);
+                          },
                           plan.groups[g].center + block.origin.head<2>()});
   }
   job.merge.radius =

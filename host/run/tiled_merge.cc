@@ -62,10 +62,14 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
   std::vector<PointCloud> read(n);
   bool all_read = true;
   for (size_t g = 0; g < n; ++g) {
-    PointCloud c = groups[g].load();
+    long count = 0;
+    PointCloud c = groups[g].load([&](const CloudPoint& p) {
+      extent[g].Add(p.position.x(), p.position.y());
+      ++count;
+      return all_read && layout.input_points + count <= options.tile_points;
+    });
     if (g == 0) layout.format = FormatOf(c);
-    for (const CloudPoint& p : c.points) extent[g].Add(p.position.x(), p.position.y());
-    layout.input_points += static_cast<long>(c.points.size());
+    layout.input_points += count;
     if (!extent[g].empty()) {
       block.Add(extent[g].xmin, extent[g].ymin);
       block.Add(extent[g].xmax, extent[g].ymax);
@@ -121,19 +125,20 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
       for (size_t g = 0; g < n; ++g) {
         clouds[g] = PointCloud{};
         if (!extent[g].Meets(reach)) continue;
-        clouds[g] = whole && all_read ? std::move(read[g]) : groups[g].load();
-        if (whole) continue;
-        auto& pts = clouds[g].points;
-        pts.erase(std::remove_if(pts.begin(), pts.end(),
-                                 [&](const CloudPoint& p) {
-                                   return !reach.Holds(p.position.x(), p.position.y());
-                                 }),
-                  pts.end());
-        pts.shrink_to_fit();  // the tile holds its share of the group, not the whole
+        if (whole) {
+          clouds[g] = all_read ? std::move(read[g]) : groups[g].load(PointFilter());
+        } else {
+          clouds[g] = groups[g].load(
+              [&](const CloudPoint& p) { return reach.Holds(p.position.x(), p.position.y()); });
+        }
       }
       MergeStats tile_stats;
-      const std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats);
+      std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats);
       PointCloud tile = layout.format;
+      tile.points.reserve(
+          static_cast<size_t>(std::count_if(refs.begin(), refs.end(), [&](const MergedRef& ref) {
+            return own(clouds[ref.group].points[ref.index]);
+          })));
       for (const MergedRef& ref : refs) {
         const CloudPoint& p = clouds[ref.group].points[ref.index];
         if (!own(p)) continue;
@@ -142,9 +147,12 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
         if (ref.core) ++st.core_by_group[ref.group];
       }
       long input = 0;
-      for (const PointCloud& c : clouds) {
+      for (PointCloud& c : clouds) {
         for (const CloudPoint& p : c.points) input += own(p);
+        // Freed before `emit`, which holds the tile's outputs in its turn.
+        c = PointCloud{};
       }
+      std::vector<MergedRef>().swap(refs);
       st.input += input;
       st.kept += static_cast<long>(tile.points.size());
       st.duplicates += input - static_cast<long>(tile.points.size());

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -65,5 +66,11 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud);
 // line of an ascii file) when the header is malformed, there is no vertex
 // element or no x y z, the data is truncated, or a coordinate is not finite.
 PointCloud ReadPly(const std::filesystem::path& path);
+// Which points a read keeps; it may also look at every point it is shown.
+using PointFilter = std::function<bool(const CloudPoint&)>;
+// The same, keeping only the points `keep` returns true for (all when it is
+// empty), in file order: a caller that needs part of a large cloud never
+// holds the rest. Each point is shown to `keep` once, after it is checked.
+PointCloud ReadPly(const std::filesystem::path& path, const PointFilter& keep);
 
 }  // namespace sapmvs

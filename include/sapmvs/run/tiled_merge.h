@@ -36,9 +36,12 @@
 namespace sapmvs {
 
 // One group of the block: its cloud, read when a tile needs it (a group's
-// checkpoint), and its ground centre (world XY), as in GroupCloud.
+// checkpoint), and its ground centre (world XY), as in GroupCloud. `load`
+// returns the points `keep` accepts (all when it is empty), in the cloud's
+// order, with the cloud's crs and has_* flags, showing `keep` every point:
+// a tile then holds its share of a group, never the whole.
 struct MergeSource {
-  std::function<PointCloud()> load;
+  std::function<PointCloud(const PointFilter& keep)> load;
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
 };
 
