@@ -434,8 +434,8 @@ TEST(GroupingMemory, GrowsLinearlyWithImages) {
   const double host_per_image = two.host_bytes - one.host_bytes;
   EXPECT_GT(host_per_image, 0);
   EXPECT_DOUBLE_EQ(six.host_bytes - one.host_bytes, 5 * host_per_image);
-  // A 972 x 648 image at level 1: 486 x 324 float32 grey + depth map.
-  EXPECT_DOUBLE_EQ(device_per_image, 8.0 * 486 * 324);
+  // A 972 x 648 image at level 1: 486 x 324 float32 grey.
+  EXPECT_DOUBLE_EQ(device_per_image, 4.0 * 486 * 324);
 }
 
 TEST(GroupingMemory, GrowsFourTimesPerLevelTowardsFullResolution) {

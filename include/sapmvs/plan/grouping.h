@@ -39,20 +39,20 @@ struct GroupMemory {
 // i, P_i its pixels at the level (sides halved per level as
 // Intrinsics::Scaled rounds them) and C_i = ceil(w/c) ceil(h/c) its cells
 // (c = MatcherOptions::cell_size, 2 by default), and M = max_wave:
-//   device = sum_i 8 P_i                      float32 grey, resident for the
-//                                             group, + a float32 depth map
+//   device = sum_i 4 P_i                      float32 grey, resident for the
+//                                             group (a device that shares
+//                                             the host's memory reads the
+//                                             host's copy; counted anyway)
 //          + M (48 + 48 + 4 + 16 (V - 1))     one wave: NccPatch, refined
 //                                             patch, view offset, and per
 //                                             view a pair, an index, a score
-//   host   = sum_i (20 P_i + b C_i)           BGR 8-bit + float32 grey +
-//                                             edge map (mask + float3 point),
-//                                             and per cell b = 17 + 4 (V - 1)
-//                                             + sizeof(AcceptedPatch) +
-//                                             sizeof(DensePoint), about 170:
-//                                             owner + tries, three float depth
-//                                             buffers, at most one accepted
-//                                             patch with its view ids and one
-//                                             dense point
+//   host   = sum_i (8 P_i + 72 C_i)           BGR 8-bit + float32 grey +
+//                                             edge mask, and per cell 72
+//                                             bytes, fitted to the measured
+//                                             peaks: the cell grids, the
+//                                             accepted patches and dense
+//                                             points, the filter's arrays
+//                                             (MatcherMemory says how)
 //          + M (candidate + result + 4 (V - 1))   the wave's host side
 //          + max_i 6 w_i h_i                 loading: one full-resolution
 //                                             BGR image, raw + undistorted
