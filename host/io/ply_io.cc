@@ -446,8 +446,6 @@ bool Declares(const PlyElement& e, Role role) {
 
 }  // namespace
 
-PointCloud ReadPly(const std::filesystem::path& path) { return ReadPly(path, PointFilter()); }
-
 PointCloud ReadPly(const std::filesystem::path& path, const PointFilter& keep) {
   const std::string file = path.string();
   if (const std::string problem = NotRegularFile(path); !problem.empty()) {

@@ -15,8 +15,6 @@ namespace {
 
 // MeanPointSpacing's sample count.
 constexpr size_t kSpacingSamples = 200000;
-// Points converted to LAS records at a time while counting.
-constexpr size_t kLasCountChunk = 65536;
 
 }  // namespace
 
@@ -50,8 +48,8 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
         // In chunks, as the writer later takes them: a tile's records and
         // extra fields at once were a third of the merge's peak.
         PointCloud chunk = l.format;
-        for (size_t at = 0; at < tile.points.size(); at += kLasCountChunk) {
-          const size_t end = std::min(tile.points.size(), at + kLasCountChunk);
+        for (size_t at = 0; at < tile.points.size(); at += PointSpill::kChunk) {
+          const size_t end = std::min(tile.points.size(), at + PointSpill::kChunk);
           chunk.points.assign(tile.points.begin() + at, tile.points.begin() + end);
           for (const PointRecord& r : ToLasRecords(chunk)) las_counts.Add(las, r, job.las.version);
           WidenExtraRanges(las, ToLasExtras(chunk), chunk.points.size(), &las_ranges);

@@ -24,9 +24,12 @@ class PointSpill {
   // Throws sapmvs::Error naming the file when a write fails (a full disk).
   void Append(const std::vector<CloudPoint>& points);
   size_t size() const { return size_; }
+  // What Read hands out at a time by default: what the writers convert at
+  // once (and the merge, which counts their records ahead of them).
+  static constexpr size_t kChunk = 1 << 16;
   // The points in the order appended, `chunk` at a time, from the start at
   // each call. Call after the last Append.
-  NextPoints Read(size_t chunk = 1 << 16);
+  NextPoints Read(size_t chunk = kChunk);
 
  private:
   AtomicFile file_;  // never committed: only its temporary name is used

@@ -65,12 +65,10 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud);
 // Throws sapmvs::InputError naming the file (and the header line, or the data
 // line of an ascii file) when the header is malformed, there is no vertex
 // element or no x y z, the data is truncated, or a coordinate is not finite.
-PointCloud ReadPly(const std::filesystem::path& path);
-// Which points a read keeps; it may also look at every point it is shown.
+// With `keep`, only the points it returns true for are kept, in file order:
+// a caller that needs part of a large cloud never holds the rest. Each point
+// is shown to `keep` once, after it is checked.
 using PointFilter = std::function<bool(const CloudPoint&)>;
-// The same, keeping only the points `keep` returns true for (all when it is
-// empty), in file order: a caller that needs part of a large cloud never
-// holds the rest. Each point is shown to `keep` once, after it is checked.
-PointCloud ReadPly(const std::filesystem::path& path, const PointFilter& keep);
+PointCloud ReadPly(const std::filesystem::path& path, const PointFilter& keep = {});
 
 }  // namespace sapmvs
