@@ -89,11 +89,13 @@ class Propagator {
     std::vector<uint8_t> tries;                            // candidates started in the cell
     int Index(const Eigen::Vector2d& uv, int cell) const;  // -1 outside
   };
-  // What a patch would emit: its points (local frame, reference pixel) and
-  // the reference cell of each (-1 outside).
+  // What a patch would emit: its points (local frame, reference pixel), the
+  // reference cell of each, and the cell each lands in in each of the
+  // patch's views, view_cells[v * points.size() + k] (-1 outside or behind).
   struct EmitPlan {
     std::vector<DensePoint> points;
     std::vector<int> ref_cells;
+    std::vector<int> view_cells;
   };
   EmitPlan PlanEmit(const AcceptedPatch& patch) const;
   // Emits the planned points of `patch` whose reference cells are still
@@ -117,6 +119,8 @@ class Propagator {
   // cut_[p]: RefitPlanes cut patch p back to its centre (with refill_cut it
   // expands from there); one per patch, pushed with it.
   std::vector<uint8_t> cut_;
+  // Emit's flags of the planned points it kept, reused between patches.
+  std::vector<uint8_t> emit_scratch_;
   std::vector<std::vector<double>> seed_depths_;
   long seeds_tried_ = 0, seeds_accepted_ = 0, candidates_ = 0, waves_ = 0, largest_wave_ = 0;
   long emitted_ = 0;
