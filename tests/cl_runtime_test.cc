@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cl_test_fixture.h"
@@ -325,6 +326,55 @@ TEST_F(ClRuntimeTest, EnqueueRoundsGlobalUpToWorkGroupMultiple) {
   EXPECT_EQ(count[0], 128);
   EXPECT_TRUE(event.profiling());
   EXPECT_GT(event.DeviceTimeNs(), 0u);
+}
+
+// Each lease has a queue of its own while the lanes last, then the main
+// one; two threads launching one kernel through Launch get their own results.
+TEST_F(ClRuntimeTest, QueueLeasesGiveEachThreadItsOwnQueue) {
+  ClContext fresh(context().device(), /*profile=*/false);
+  const cl_command_queue main = fresh.queue();
+  ASSERT_EQ(ClContext::kLanes, 2);
+  std::set<cl_command_queue> seen;
+  {
+    const ClContext::QueueLease first = fresh.LeaseQueue();
+    seen.insert(fresh.queue());
+    std::thread([&] {
+      const ClContext::QueueLease second = fresh.LeaseQueue();
+      seen.insert(fresh.queue());
+      // All lanes leased: a third thread's lease falls back to the main queue.
+      std::thread([&] {
+        const ClContext::QueueLease third = fresh.LeaseQueue();
+        EXPECT_EQ(fresh.queue(), main);
+      }).join();
+    }).join();
+    // Another thread's lease does not move this one's.
+    EXPECT_EQ(seen.count(fresh.queue()), 1u);
+  }
+  EXPECT_EQ(seen.size(), 2u);
+  EXPECT_EQ(seen.count(main), 0u);
+  EXPECT_EQ(fresh.queue(), main);
+
+  ClKernel kernel =
+      fresh.ProgramFromSource("iota_lease_test", kIotaSource, {{"SCALE", "5"}}).Kernel("iota");
+  auto launches = [&](int n, bool* right) {
+    const ClContext::QueueLease lease = fresh.LeaseQueue();
+    *right = true;
+    for (int round = 0; round < 20; ++round) {
+      ClBuffer out(fresh, n * sizeof(cl_int));
+      ClBuffer launched(fresh, sizeof(cl_int));
+      launched.WriteVector(std::vector<cl_int>{0});
+      fresh.Launch(kernel, static_cast<size_t>(n), 1, out, cl_int{n}, launched);
+      std::vector<cl_int> values(n);
+      out.ReadVector(&values);
+      for (int i = 0; i < n; ++i) *right = *right && values[i] == 5 * i;
+    }
+  };
+  bool right_a = false, right_b = false;
+  std::thread a(launches, 301, &right_a);
+  launches(517, &right_b);
+  a.join();
+  EXPECT_TRUE(right_a);
+  EXPECT_TRUE(right_b);
 }
 
 TEST_F(ClRuntimeTest, WorkGroupLargerThanDeviceMaxThrowsBeforeEnqueue) {

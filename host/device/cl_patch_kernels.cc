@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <map>
+#include <mutex>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -82,8 +83,11 @@ class ClPatchKernels : public PatchKernels {
     }
   }
 
+  bool ConcurrentLaunches() const override { return true; }
+
   std::vector<float> Score(const NccScorerOptions& options, const std::vector<NccPatch>& patches,
                            const std::vector<NccPair>& pairs, double* seconds) override {
+    const ClContext::QueueLease lease = context_.LeaseQueue();
     ClEvent event;
     std::vector<float> scores = ScorerFor(options).Score(patches, pairs, &event);
     if (seconds != nullptr) *seconds = Seconds(event);
@@ -94,6 +98,7 @@ class ClPatchKernels : public PatchKernels {
                                    const std::vector<NccPatch>& patches,
                                    const std::vector<std::vector<int>>& views,
                                    double* seconds) override {
+    const ClContext::QueueLease lease = context_.LeaseQueue();
     ClEvent event;
     std::vector<RefinedPatch> refined = RefinerFor(options).Refine(patches, views, &event);
     if (seconds != nullptr) *seconds = Seconds(event);
@@ -101,7 +106,9 @@ class ClPatchKernels : public PatchKernels {
   }
 
  private:
+  // Under lookup_mutex_: launches on two threads may make the first of a kind.
   NccScorer& ScorerFor(const NccScorerOptions& options) {
+    std::lock_guard<std::mutex> lock(lookup_mutex_);
     if (!group_) throw Error("PatchKernels::Score called before SetGroup");
     std::unique_ptr<NccScorer>& scorer = scorers_[KeyOf(options)];
     if (!scorer) {
@@ -113,6 +120,7 @@ class ClPatchKernels : public PatchKernels {
   }
 
   PatchRefiner& RefinerFor(const PatchRefinerOptions& options) {
+    std::lock_guard<std::mutex> lock(lookup_mutex_);
     if (!group_) throw Error("PatchKernels::Refine called before SetGroup");
     std::unique_ptr<PatchRefiner>& refiner = refiners_[KeyOf(options)];
     if (!refiner) {
@@ -130,6 +138,7 @@ class ClPatchKernels : public PatchKernels {
   std::vector<NccCamera> cameras_;
   std::map<ScorerKey, std::unique_ptr<NccScorer>> scorers_;
   std::map<RefinerKey, std::unique_ptr<PatchRefiner>> refiners_;
+  std::mutex lookup_mutex_;
 };
 
 }  // namespace

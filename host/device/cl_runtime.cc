@@ -496,12 +496,49 @@ ClContext::ClContext(const DeviceInfo& device, bool profile)
     throw ClError(status, "clCreateContext", __FILE__, __LINE__, "device " + device.Describe());
   }
   const cl_command_queue_properties queue_properties = profile ? CL_QUEUE_PROFILING_ENABLE : 0;
-  queue_ = internal::ClHandle<cl_command_queue>(
-      clCreateCommandQueue(context_.get(), device.id, queue_properties, &status));
-  if (status != CL_SUCCESS) {
-    throw ClError(status, "clCreateCommandQueue", __FILE__, __LINE__,
-                  "device " + device.Describe());
+  for (int q = -1; q < kLanes; ++q) {
+    internal::ClHandle<cl_command_queue> made(
+        clCreateCommandQueue(context_.get(), device.id, queue_properties, &status));
+    if (status != CL_SUCCESS) {
+      throw ClError(status, "clCreateCommandQueue", __FILE__, __LINE__,
+                    "device " + device.Describe());
+    }
+    (q < 0 ? queue_ : lanes_[q]) = std::move(made);
   }
+}
+
+namespace {
+// The calling thread's lease: which context, which of its lanes.
+thread_local const ClContext* lease_context = nullptr;
+thread_local int lease_lane = -1;
+}  // namespace
+
+ClContext::QueueLease::QueueLease(ClContext& context) : context_(context) {
+  std::lock_guard<std::mutex> lock(*context_.mutex_);
+  for (int q = 0; q < kLanes; ++q) {
+    if (!context_.leased_[q] && context_.lanes_[q]) {
+      context_.leased_[q] = true;
+      lane_ = q;
+      break;
+    }
+  }
+  if (lane_ >= 0) {
+    lease_context = &context_;
+    lease_lane = lane_;
+  }
+}
+
+ClContext::QueueLease::~QueueLease() {
+  if (lane_ < 0) return;
+  lease_context = nullptr;
+  lease_lane = -1;
+  std::lock_guard<std::mutex> lock(*context_.mutex_);
+  context_.leased_[lane_] = false;
+}
+
+cl_command_queue ClContext::queue() const {
+  if (lease_context == this && lease_lane >= 0) return lanes_[lease_lane].get();
+  return queue_.get();
 }
 
 ClContext::~ClContext() { Release(); }
@@ -513,17 +550,23 @@ ClContext& ClContext::operator=(ClContext&& other) noexcept {
     profiling_ = other.profiling_;
     context_ = std::move(other.context_);
     queue_ = std::move(other.queue_);
+    lanes_ = std::move(other.lanes_);
+    leased_ = other.leased_;
+    mutex_ = std::move(other.mutex_);
     programs_ = std::move(other.programs_);
   }
   return *this;
 }
 
 void ClContext::Release() noexcept {
-  if (queue_) {
-    const cl_int status = clFinish(queue_.get());
+  for (int q = -1; q < kLanes; ++q) {
+    const internal::ClHandle<cl_command_queue>& handle = q < 0 ? queue_ : lanes_[q];
+    if (!handle) continue;
+    const cl_int status = clFinish(handle.get());
     if (status != CL_SUCCESS) internal::LogClFailure(status, "clFinish", __FILE__, __LINE__);
   }
   programs_.clear();
+  for (internal::ClHandle<cl_command_queue>& lane : lanes_) lane.Reset();
   queue_.Reset();
   context_.Reset();
 }
@@ -611,7 +654,7 @@ ClEvent ClContext::Enqueue(const ClKernel& kernel, const NDRange& global, const 
   }
   cl_event event = nullptr;
   const cl_int status =
-      clEnqueueNDRangeKernel(queue_.get(), kernel.get(), global.dims, nullptr, rounded.sizes.data(),
+      clEnqueueNDRangeKernel(queue(), kernel.get(), global.dims, nullptr, rounded.sizes.data(),
                              local.sizes.data(), 0, nullptr, &event);
   if (status != CL_SUCCESS) {
     throw ClError(status, "clEnqueueNDRangeKernel", __FILE__, __LINE__,
@@ -621,6 +664,11 @@ ClEvent ClContext::Enqueue(const ClKernel& kernel, const NDRange& global, const 
   return ClEvent(event, profiling_);
 }
 
-void ClContext::Finish() const { CL_CHECK(clFinish(queue_.get())); }
+void ClContext::Finish() const {
+  CL_CHECK(clFinish(queue_.get()));
+  for (const internal::ClHandle<cl_command_queue>& lane : lanes_) {
+    if (lane) CL_CHECK(clFinish(lane.get()));
+  }
+}
 
 }  // namespace sapmvs

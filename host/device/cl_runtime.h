@@ -1,12 +1,15 @@
 #pragma once
 // The OpenCL runtime layer: device discovery and selection, one context with
-// one in-order queue, thin RAII wrappers over the C API (movable, not
+// in-order queues, thin RAII wrappers over the C API (movable, not
 // copyable, in the manner of CLBlast's clpp11) and a program cache. Every
 // kernel launch goes through ClContext::Enqueue, which checks work-group
 // limits first so a bad launch fails with a sentence rather than
 // CL_INVALID_WORK_GROUP_SIZE.
 //
-// Nothing here is thread-safe: use one ClContext per host thread.
+// Two host threads may share a ClContext only as the patch kernels do: each
+// in a queue lease (ClContext::LeaseQueue), launching through
+// ClContext::Launch on objects that both only read, after one thread made
+// them. Nothing else here is thread-safe.
 
 #include <CL/cl.h>
 
@@ -16,6 +19,7 @@
 #include <initializer_list>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -375,10 +379,32 @@ class BuildOptions {
   std::map<std::string, std::string> defines_;
 };
 
-// The selected device's context and its single in-order queue, plus the
-// program cache. Movable; programs handed out stay valid while it lives.
+// The selected device's context, its in-order queue and kLanes more, plus
+// the program cache. Movable; programs handed out stay valid while it lives.
 class ClContext {
  public:
+  // Queues besides the main one that leases hand out.
+  static constexpr int kLanes = 2;
+
+  // While it lives, the launches and buffer copies its thread makes on its
+  // context go to a queue no other lease holds, not to the main queue (to
+  // the main queue when every lane is leased). On one in-order queue, two
+  // host threads' launches ran one after the other, and a launch's last
+  // work-groups left PoCL's other threads idle; on two queues the device
+  // runs both (PoCL's threads take the work-groups of either; a GPU
+  // overlaps the kernels). Not movable; one per thread at a time.
+  class QueueLease {
+   public:
+    ~QueueLease();
+    QueueLease(const QueueLease&) = delete;
+    QueueLease& operator=(const QueueLease&) = delete;
+
+   private:
+    friend class ClContext;
+    explicit QueueLease(ClContext& context);
+    ClContext& context_;
+    int lane_ = -1;
+  };
   // Selects a device as described in DeviceOptions. Throws NoDeviceError.
   explicit ClContext(const DeviceOptions& options = DeviceOptions());
   ClContext(const DeviceInfo& device, bool profile);
@@ -396,7 +422,9 @@ class ClContext {
   const DeviceInfo& device() const { return device_; }
   cl_device_id device_id() const { return device_.id; }
   cl_context context() const { return context_.get(); }
-  cl_command_queue queue() const { return queue_.get(); }
+  // The calling thread's queue: its lease's lane, else the main queue.
+  cl_command_queue queue() const;
+  QueueLease LeaseQueue() { return QueueLease(*this); }
   bool profiling() const { return profiling_; }
 
   // The program built from kernels/<kernel_file> (see KernelSource) with
@@ -414,8 +442,18 @@ class ClContext {
   // throws Error before enqueueing if it cannot run; rounds `global` up to a
   // multiple of `local`, so the kernel must bounds-check its global id.
   ClEvent Enqueue(const ClKernel& kernel, const NDRange& global, const NDRange& local);
+  // kernel.SetArgs(args...) and Enqueue as one step under the context's
+  // lock: a kernel's arguments are its own state until the enqueue copies
+  // them, so two threads launching one kernel must not interleave the two.
+  template <typename... Args>
+  ClEvent Launch(ClKernel& kernel, const NDRange& global, const NDRange& local,
+                 const Args&... args) {
+    std::lock_guard<std::mutex> lock(*mutex_);
+    kernel.SetArgs(args...);
+    return Enqueue(kernel, global, local);
+  }
 
-  // Blocks until every queued command has finished.
+  // Blocks until every command queued on any of its queues has finished.
   void Finish() const;
 
  private:
@@ -434,6 +472,10 @@ class ClContext {
   bool profiling_ = false;
   internal::ClHandle<cl_context> context_;
   internal::ClHandle<cl_command_queue> queue_;
+  std::array<internal::ClHandle<cl_command_queue>, kLanes> lanes_;
+  std::array<bool, kLanes> leased_{};
+  // Guards leased_ and Launch; a pointer so that the context stays movable.
+  std::unique_ptr<std::mutex> mutex_ = std::make_unique<std::mutex>();
   std::map<CacheKey, CacheEntry> programs_;
 };
 

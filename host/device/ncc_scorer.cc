@@ -126,12 +126,11 @@ std::vector<float> NccScorer::Score(const std::vector<NccPatch>& patches,
   run_buffer.WriteVector(run_offsets);
   ClBuffer score_buffer(context_, pairs.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
-  score_kernel_.SetArgs(group_->images, group_->image_table, group_->cameras,
-                        cl_int{group_->num_images}, patch_buffer,
-                        static_cast<cl_int>(patches.size()), pair_buffer, run_buffer,
-                        static_cast<cl_int>(num_runs), score_buffer);
-  ClEvent launched = context_.Enqueue(score_kernel_, NDRange(num_runs),
-                                      NDRange(static_cast<size_t>(options_.work_group_size)));
+  ClEvent launched = context_.Launch(
+      score_kernel_, NDRange(num_runs), NDRange(static_cast<size_t>(options_.work_group_size)),
+      group_->images, group_->image_table, group_->cameras, cl_int{group_->num_images},
+      patch_buffer, static_cast<cl_int>(patches.size()), pair_buffer, run_buffer,
+      static_cast<cl_int>(num_runs), score_buffer);
   // The blocking read on the in-order queue waits for the kernel.
   std::vector<float> scores(pairs.size());
   score_buffer.ReadVector(&scores);
@@ -150,10 +149,10 @@ std::vector<float> NccScorer::ProbeSamples(int image, const std::vector<Eigen::V
   ClBuffer point_buffer(context_, points.size() * sizeof(Eigen::Vector2f), CL_MEM_READ_ONLY);
   point_buffer.Write(points.data(), points.size() * sizeof(Eigen::Vector2f));
   ClBuffer value_buffer(context_, points.size() * sizeof(float), CL_MEM_WRITE_ONLY);
-  probe_kernel_.SetArgs(group_->images, group_->image_table, cl_int{image}, point_buffer,
-                        static_cast<cl_int>(points.size()), value_buffer);
-  context_.Enqueue(probe_kernel_, NDRange(points.size()),
-                   NDRange(static_cast<size_t>(options_.work_group_size)));
+  context_.Launch(probe_kernel_, NDRange(points.size()),
+                  NDRange(static_cast<size_t>(options_.work_group_size)), group_->images,
+                  group_->image_table, cl_int{image}, point_buffer,
+                  static_cast<cl_int>(points.size()), value_buffer);
   std::vector<float> values(points.size());
   value_buffer.ReadVector(&values);
   return values;

@@ -68,15 +68,14 @@ std::vector<RefinedPatch> PatchRefiner::Refine(const std::vector<NccPatch>& patc
   ClBuffer result_buffer(context_, patches.size() * sizeof(RefinedPatchOut), CL_MEM_WRITE_ONLY);
   ClBuffer score_buffer(context_, indices.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
-  kernel_.SetArgs(group_->images, group_->image_table, group_->cameras, cl_int{group_->num_images},
-                  patch_buffer, static_cast<cl_int>(patches.size()), offset_buffer, index_buffer,
-                  cl_int{options_.iterations}, cl_int{options_.max_halvings},
-                  static_cast<cl_float>(options_.depth_step),
-                  static_cast<cl_float>(Radians(options_.angle_step_deg)),
-                  static_cast<cl_float>(Radians(options_.max_angle_deg)), result_buffer,
-                  score_buffer);
-  ClEvent launched = context_.Enqueue(kernel_, NDRange(patches.size()),
-                                      NDRange(static_cast<size_t>(options_.work_group_size)));
+  ClEvent launched = context_.Launch(
+      kernel_, NDRange(patches.size()), NDRange(static_cast<size_t>(options_.work_group_size)),
+      group_->images, group_->image_table, group_->cameras, cl_int{group_->num_images},
+      patch_buffer, static_cast<cl_int>(patches.size()), offset_buffer, index_buffer,
+      cl_int{options_.iterations}, cl_int{options_.max_halvings},
+      static_cast<cl_float>(options_.depth_step),
+      static_cast<cl_float>(Radians(options_.angle_step_deg)),
+      static_cast<cl_float>(Radians(options_.max_angle_deg)), result_buffer, score_buffer);
   std::vector<RefinedPatchOut> out(patches.size());
   result_buffer.ReadVector(&out);
   std::vector<float> scores(indices.size());

@@ -113,8 +113,12 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
                                                   const std::vector<std::vector<int>>& views) {
   if (patches.empty()) return {};
   double seconds = 0;
-  std::lock_guard<std::mutex> lock(launch_mutex_);
-  std::vector<RefinedPatch> out = kernels_.Refine(ro, patches, views, &seconds);
+  std::vector<RefinedPatch> out;
+  {
+    std::unique_lock<std::mutex> lock(launch_mutex_, std::defer_lock);
+    if (!kernels_.ConcurrentLaunches()) lock.lock();
+    out = kernels_.Refine(ro, patches, views, &seconds);
+  }
   // Labelled by the window's side in pixels.
   const int size = static_cast<int>(std::lround((ro.patch_size - 1) * ro.sample_step)) + 1;
   double evaluations = 0;
@@ -128,6 +132,7 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
 
 void PatchEngine::Count(const std::string& kernel, int patch_size, long items,
                         double ncc_evaluations, double seconds) {
+  std::lock_guard<std::mutex> lock(count_mutex_);
   KernelTime& t = kernel_times_[kernel];
   ++t.launches;
   t.items += items;
@@ -144,8 +149,12 @@ std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& p
   if (pairs.empty()) return {};
   const NccScorerOptions so = ScoreOptionsOf(options_, size);
   double seconds = 0;
-  std::lock_guard<std::mutex> lock(launch_mutex_);
-  std::vector<float> scores = kernels_.Score(so, patches, pairs, &seconds);
+  std::vector<float> scores;
+  {
+    std::unique_lock<std::mutex> lock(launch_mutex_, std::defer_lock);
+    if (!kernels_.ConcurrentLaunches()) lock.lock();
+    scores = kernels_.Score(so, patches, pairs, &seconds);
+  }
   Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size), size,
         static_cast<long>(pairs.size()), static_cast<double>(pairs.size()), seconds);
   return scores;

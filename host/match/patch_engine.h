@@ -88,7 +88,8 @@ class PatchEngine {
   // One result per candidate, in order; nullopt = rejected. A candidate's
   // result does not depend on the others in the batch, so a large batch is
   // evaluated as two halves on two threads: while one half's host steps run,
-  // the other half's kernels keep the device busy.
+  // the other half's kernels keep the device busy, and on an OpenCL device
+  // the two halves' kernels run together (ClContext::QueueLease).
   std::vector<std::optional<AcceptedPatch>> Evaluate(const std::vector<PatchCandidate>& candidates);
 
   // NCC of patches (centre, normal, ref) against `view`, window_size grid:
@@ -139,9 +140,11 @@ class PatchEngine {
   PatchRefinerOptions refine_options_;
   std::map<int, PatchRefinerOptions> polish_options_;  // by patch side (sapmvs)
   std::map<std::string, KernelTime> kernel_times_;
-  // Held for each launch and its count: PatchKernels takes one call at a
-  // time, and the halves of Evaluate launch from two threads.
+  // The halves of Evaluate launch from two threads. launch_mutex_ is held
+  // for each launch unless the kernels take concurrent launches (the OpenCL
+  // backend, whose launches then run together); count_mutex_ for each count.
   std::mutex launch_mutex_;
+  std::mutex count_mutex_;
 };
 
 }  // namespace sapmvs

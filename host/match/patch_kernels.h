@@ -62,6 +62,10 @@ class PatchKernels {
   virtual double PeakDeviceBytes() const { return 0; }
   virtual void ResetPeakDeviceBytes() {}
 
+  // True when Score and Refine may be called from two threads at once, whose
+  // launches then run together.
+  virtual bool ConcurrentLaunches() const { return false; }
+
   // scores[i] = NCC of pairs[i] at options.patch_size with options'
   // sample weights, NaN where undefined. Throws Error for bad options or a
   // bad batch (ValidateNccBatch) before any work. `seconds` (may be null)
