@@ -48,18 +48,24 @@ std::vector<fs::path> FilesUnder(const fs::path& dir) {
 }
 
 TEST(Simulate, SameSeedSameBytesOtherSeedOtherImages) {
-  const fs::path dir = test::ScratchDir();
-  Simulate(Tiny(dir / "a", 0.5, 7));
-  Simulate(Tiny(dir / "b", 0.5, 7));
-  Simulate(Tiny(dir / "c", 0.5, 8));
-  const auto files = FilesUnder(dir / "a");
+  // `a` is the folder the other tests share; `b` renders it again.
+  const fs::path a = test::Simulated("tiny", 1, 0.5), dir = test::ScratchDir();
+  SimulateOptions o = test::SimulatedOptions("tiny", 1, 0.5);
+  o.out = dir / "b";
+  const SimulateSummary summary = Simulate(o);
+  EXPECT_EQ(static_cast<long>(ReadLas(dir / "b/truth/lidar.las").points.size()),
+            summary.lidar_points);
+  o.seed = 2;
+  o.out = dir / "c";
+  Simulate(o);
+  const auto files = FilesUnder(a);
   ASSERT_EQ(files, FilesUnder(dir / "b"));
-  EXPECT_TRUE(fs::is_regular_file(dir / "a" / ".sapmvs_simulate"));
-  ASSERT_GE(files.size(), 9u);  // block, orientation, 4 images, dsm, las, exposure, README
+  EXPECT_TRUE(fs::is_regular_file(a / ".sapmvs_simulate"));
+  ASSERT_GE(files.size(), 10u);  // block, orientation, 4 images, dsm, las, xyz, exposure, README
   for (const fs::path& f : files) {
-    EXPECT_TRUE(Slurp(dir / "a" / f) == Slurp(dir / "b" / f)) << f << " differs between runs";
+    EXPECT_TRUE(Slurp(a / f) == Slurp(dir / "b" / f)) << f << " differs between runs";
   }
-  EXPECT_FALSE(Slurp(dir / "a/images/IMG_0001.png") == Slurp(dir / "c/images/IMG_0001.png"));
+  EXPECT_FALSE(Slurp(a / "images/IMG_0001.png") == Slurp(dir / "c/images/IMG_0001.png"));
   // No temporary files are left behind.
   for (const fs::path& f : files) EXPECT_NE(f.filename().string().front(), '.') << f;
 }
@@ -98,9 +104,9 @@ double Pearson(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 TEST(Simulate, DsmPointsProjectOntoTheirShadedTexture) {
-  const fs::path dir = test::ScratchDir();
-  const SimulateOptions o = Tiny(dir);
-  Simulate(o);
+  const fs::path dir = test::Simulated("tiny", 3);
+  SimulateOptions o = test::SimulatedOptions("tiny", 3);
+  o.out = dir;
   // Everything goes through the product's readers: block.yaml, GeoTIFF.
   const Block block = ReadBlock(dir / "block.yaml");
   ASSERT_EQ(block.images.size(), 4u);
@@ -164,18 +170,14 @@ TEST(Simulate, DsmPointsProjectOntoTheirShadedTexture) {
 }
 
 TEST(Simulate, TruthFilesAreValidAndAgree) {
-  const fs::path dir = test::ScratchDir();
-  SimulateOptions o = Tiny(dir);
-  o.xyz = true;
-  const SimulateSummary s = Simulate(o);
-  EXPECT_EQ(static_cast<long>(ReadXyz(dir / "truth" / "lidar.xyz").points.size()), s.lidar_points);
+  const fs::path dir = test::Simulated("tiny", 3);
   const GeoRaster dsm = ReadGeoRaster(dir / "truth" / "dsm.tif");
   EXPECT_NE(dsm.crs.find("32632"), std::string::npos);
   // UTM-like coordinates, so float32 mistakes show.
   EXPECT_GT(dsm.origin_x, 4.9e5);
   EXPECT_GT(dsm.origin_y, 5.39e6);
   const LasCloud las = ReadLas(dir / "truth" / "lidar.las");
-  EXPECT_EQ(static_cast<long>(las.points.size()), s.lidar_points);
+  EXPECT_EQ(ReadXyz(dir / "truth" / "lidar.xyz").points.size(), las.points.size());
   EXPECT_FALSE(las.crs_wkt.empty());
   ASSERT_GT(las.points.size(), 10000u);
   // Ground returns lie on the DSM (2 cm vertical noise, 5 cm horizontal on

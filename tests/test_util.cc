@@ -82,16 +82,22 @@ fs::path SharedFolder(const std::string& id, const std::function<void(const fs::
   return dir;
 }
 
+SimulateOptions SimulatedOptions(const std::string& preset, int seed, double scale) {
+  SimulateOptions o;
+  o.preset = preset;
+  o.seed = seed;
+  o.scale = scale;
+  o.quiet = true;
+  o.xyz = true;
+  return o;
+}
+
 fs::path Simulated(const std::string& preset, int seed, double scale) {
   std::ostringstream id;
   id << preset << "_seed" << seed << "_scale" << scale;
   return SharedFolder(id.str(), [&](const fs::path& dir) {
-    SimulateOptions o;
-    o.preset = preset;
+    SimulateOptions o = SimulatedOptions(preset, seed, scale);
     o.out = dir;
-    o.seed = seed;
-    o.scale = scale;
-    o.quiet = true;
     Simulate(o);
   });
 }

@@ -12,6 +12,7 @@
 
 #include "sapmvs/block/camera.h"
 #include "sapmvs/block/image_io.h"
+#include "sapmvs/simulate/simulate.h"
 
 namespace sapmvs::test {
 
@@ -33,8 +34,14 @@ std::filesystem::path ScratchDir();
 std::filesystem::path SharedFolder(const std::string& id,
                                    const std::function<void(const std::filesystem::path&)>& make);
 
+// The options Simulated() runs the simulator with (quiet, truth/lidar.xyz
+// too), without `out`: a test can rebuild the same world or render the same
+// block again.
+SimulateOptions SimulatedOptions(const std::string& preset, int seed, double scale = 1.0);
 // The simulator's `preset` rendered with `seed` at `scale` (a SharedFolder).
-// Read only: a test that needs a changed block copies it.
+// Read only: a test that needs a changed block copies it. The simulator is
+// the slowest thing the sanitizer build runs, so tests share these folders
+// rather than simulate their own.
 std::filesystem::path Simulated(const std::string& preset, int seed, double scale = 1.0);
 
 // Kernel-versus-reference comparison: |actual - expected| <= abs_tol + rel_tol
