@@ -496,49 +496,47 @@ ClContext::ClContext(const DeviceInfo& device, bool profile)
     throw ClError(status, "clCreateContext", __FILE__, __LINE__, "device " + device.Describe());
   }
   const cl_command_queue_properties queue_properties = profile ? CL_QUEUE_PROFILING_ENABLE : 0;
-  for (int q = -1; q < kLanes; ++q) {
-    internal::ClHandle<cl_command_queue> made(
+  for (internal::ClHandle<cl_command_queue>& queue : queues_) {
+    queue = internal::ClHandle<cl_command_queue>(
         clCreateCommandQueue(context_.get(), device.id, queue_properties, &status));
     if (status != CL_SUCCESS) {
       throw ClError(status, "clCreateCommandQueue", __FILE__, __LINE__,
                     "device " + device.Describe());
     }
-    (q < 0 ? queue_ : lanes_[q]) = std::move(made);
   }
 }
 
 namespace {
-// The calling thread's lease: which context, which of its lanes.
+// The calling thread's lease: which context, which of its queues.
 thread_local const ClContext* lease_context = nullptr;
-thread_local int lease_lane = -1;
+thread_local int lease_lane = 0;
 }  // namespace
 
 ClContext::QueueLease::QueueLease(ClContext& context) : context_(context) {
   std::lock_guard<std::mutex> lock(*context_.mutex_);
-  for (int q = 0; q < kLanes; ++q) {
-    if (!context_.leased_[q] && context_.lanes_[q]) {
+  for (int q = 1; q <= kLanes; ++q) {
+    if (!context_.leased_[q] && context_.queues_[q]) {
       context_.leased_[q] = true;
       lane_ = q;
       break;
     }
   }
-  if (lane_ >= 0) {
+  if (lane_ > 0) {
     lease_context = &context_;
     lease_lane = lane_;
   }
 }
 
 ClContext::QueueLease::~QueueLease() {
-  if (lane_ < 0) return;
+  if (lane_ == 0) return;
   lease_context = nullptr;
-  lease_lane = -1;
+  lease_lane = 0;
   std::lock_guard<std::mutex> lock(*context_.mutex_);
   context_.leased_[lane_] = false;
 }
 
 cl_command_queue ClContext::queue() const {
-  if (lease_context == this && lease_lane >= 0) return lanes_[lease_lane].get();
-  return queue_.get();
+  return queues_[lease_context == this ? lease_lane : 0].get();
 }
 
 ClContext::~ClContext() { Release(); }
@@ -549,8 +547,7 @@ ClContext& ClContext::operator=(ClContext&& other) noexcept {
     device_ = std::move(other.device_);
     profiling_ = other.profiling_;
     context_ = std::move(other.context_);
-    queue_ = std::move(other.queue_);
-    lanes_ = std::move(other.lanes_);
+    queues_ = std::move(other.queues_);
     leased_ = other.leased_;
     mutex_ = std::move(other.mutex_);
     programs_ = std::move(other.programs_);
@@ -559,15 +556,13 @@ ClContext& ClContext::operator=(ClContext&& other) noexcept {
 }
 
 void ClContext::Release() noexcept {
-  for (int q = -1; q < kLanes; ++q) {
-    const internal::ClHandle<cl_command_queue>& handle = q < 0 ? queue_ : lanes_[q];
-    if (!handle) continue;
-    const cl_int status = clFinish(handle.get());
+  for (const internal::ClHandle<cl_command_queue>& queue : queues_) {
+    if (!queue) continue;
+    const cl_int status = clFinish(queue.get());
     if (status != CL_SUCCESS) internal::LogClFailure(status, "clFinish", __FILE__, __LINE__);
   }
   programs_.clear();
-  for (internal::ClHandle<cl_command_queue>& lane : lanes_) lane.Reset();
-  queue_.Reset();
+  for (internal::ClHandle<cl_command_queue>& queue : queues_) queue.Reset();
   context_.Reset();
 }
 
@@ -665,9 +660,8 @@ ClEvent ClContext::Enqueue(const ClKernel& kernel, const NDRange& global, const 
 }
 
 void ClContext::Finish() const {
-  CL_CHECK(clFinish(queue_.get()));
-  for (const internal::ClHandle<cl_command_queue>& lane : lanes_) {
-    if (lane) CL_CHECK(clFinish(lane.get()));
+  for (const internal::ClHandle<cl_command_queue>& queue : queues_) {
+    if (queue) CL_CHECK(clFinish(queue.get()));
   }
 }
 

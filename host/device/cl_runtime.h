@@ -403,7 +403,7 @@ class ClContext {
     friend class ClContext;
     explicit QueueLease(ClContext& context);
     ClContext& context_;
-    int lane_ = -1;
+    int lane_ = 0;  // an index into queues_; 0, the main queue, is never leased
   };
   // Selects a device as described in DeviceOptions. Throws NoDeviceError.
   explicit ClContext(const DeviceOptions& options = DeviceOptions());
@@ -471,9 +471,9 @@ class ClContext {
   DeviceInfo device_;
   bool profiling_ = false;
   internal::ClHandle<cl_context> context_;
-  internal::ClHandle<cl_command_queue> queue_;
-  std::array<internal::ClHandle<cl_command_queue>, kLanes> lanes_;
-  std::array<bool, kLanes> leased_{};
+  // The main queue at 0, the lanes after it.
+  std::array<internal::ClHandle<cl_command_queue>, 1 + kLanes> queues_;
+  std::array<bool, 1 + kLanes> leased_{};
   // Guards leased_ and Launch; a pointer so that the context stays movable.
   std::unique_ptr<std::mutex> mutex_ = std::make_unique<std::mutex>();
   std::map<CacheKey, CacheEntry> programs_;

@@ -115,8 +115,7 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
   double seconds = 0;
   std::vector<RefinedPatch> out;
   {
-    std::unique_lock<std::mutex> lock(launch_mutex_, std::defer_lock);
-    if (!kernels_.ConcurrentLaunches()) lock.lock();
+    const std::unique_lock<std::mutex> lock = LaunchLock();
     out = kernels_.Refine(ro, patches, views, &seconds);
   }
   // Labelled by the window's side in pixels.
@@ -128,6 +127,11 @@ std::vector<RefinedPatch> PatchEngine::RefineWith(const PatchRefinerOptions& ro,
   Count("patch_refine " + std::to_string(size) + "x" + std::to_string(size), ro.patch_size,
         static_cast<long>(patches.size()), evaluations, seconds);
   return out;
+}
+
+std::unique_lock<std::mutex> PatchEngine::LaunchLock() {
+  if (kernels_.ConcurrentLaunches()) return {};
+  return std::unique_lock<std::mutex>(launch_mutex_);
 }
 
 void PatchEngine::Count(const std::string& kernel, int patch_size, long items,
@@ -151,8 +155,7 @@ std::vector<float> PatchEngine::ScoreAt(int size, const std::vector<NccPatch>& p
   double seconds = 0;
   std::vector<float> scores;
   {
-    std::unique_lock<std::mutex> lock(launch_mutex_, std::defer_lock);
-    if (!kernels_.ConcurrentLaunches()) lock.lock();
+    const std::unique_lock<std::mutex> lock = LaunchLock();
     scores = kernels_.Score(so, patches, pairs, &seconds);
   }
   Count("ncc_score " + std::to_string(size) + "x" + std::to_string(size), size,

@@ -128,6 +128,8 @@ class PatchEngine {
       const std::vector<PatchCandidate>& candidates);
   std::vector<float> ScoreAt(int size, const std::vector<NccPatch>& patches,
                              const std::vector<NccPair>& pairs);
+  // launch_mutex_, locked, unless the kernels take concurrent launches.
+  std::unique_lock<std::mutex> LaunchLock();
   void Count(const std::string& kernel, int patch_size, long items, double ncc_evaluations,
              double seconds);
   std::vector<RefinedPatch> RefineWith(const PatchRefinerOptions& options,
