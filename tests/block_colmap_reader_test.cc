@@ -13,8 +13,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path HerzJesu() { return test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"; }
-
 // Writes `block` as a COLMAP project: images/ (links) and sparse/0/*.txt, with
 // COLMAP's pixel convention (+0.5). No COLMAP model ships with the shared
 // data, so the reader is checked on the Herz-Jesu cameras written in it.
@@ -46,8 +44,8 @@ fs::path WriteColmap(const Block& block, const fs::path& project) {
 }
 
 TEST(ColmapReader, ReadsHerzJesuWrittenAsColmap) {
-  SAPMVS_REQUIRE_PATH(HerzJesu());
-  const Block ref = ReadBlock(HerzJesu());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const Block ref = ReadBlock(test::HerzJesu());
   const fs::path project = WriteColmap(ref, test::ScratchDir());
   EXPECT_EQ(DetectBlockFormat(project), BlockFormat::kColmap);
   for (const fs::path& given :
@@ -76,7 +74,7 @@ fs::path OneImageProject(const std::string& cameras, const std::string& images) 
 }
 
 TEST(ColmapReader, CameraModelsMapToOpenCvIntrinsics) {
-  SAPMVS_REQUIRE_PATH(HerzJesu());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
   const fs::path dir = OneImageProject(
       "1 SIMPLE_PINHOLE 3072 2048 2800 1536 1024\n"
       "2 SIMPLE_RADIAL 3072 2048 2800 1536 1024 -0.1\n"
@@ -85,7 +83,7 @@ TEST(ColmapReader, CameraModelsMapToOpenCvIntrinsics) {
       "1 1 0 0 0 0 0 0 1 0000.jpg\n\n2 1 0 0 0 0 0 1 2 0001.jpg\n\n"
       "3 1 0 0 0 0 0 2 3 0002.jpg\n\n4 1 0 0 0 0 0 3 4 0003.jpg\n\n");
   for (const char* name : {"0000.jpg", "0001.jpg", "0002.jpg", "0003.jpg"}) {
-    fs::create_symlink(HerzJesu() / "images" / name, dir / "images" / name);
+    fs::create_symlink(test::HerzJesu() / "images" / name, dir / "images" / name);
   }
   const Block b = ReadBlock(dir);
   ASSERT_EQ(b.images.size(), 4u);
@@ -102,7 +100,7 @@ TEST(ColmapReader, CameraModelsMapToOpenCvIntrinsics) {
   EXPECT_LT((b.images[2].camera.center() - Eigen::Vector3d(0, 0, -2)).norm(), 1e-12);
 }
 
-struct Malformed {
+struct ColmapMalformed {
   std::string name;
   std::string cameras;
   std::string images;
@@ -112,12 +110,12 @@ struct Malformed {
 };
 
 // Keeps ctest's discovered test names stable (no byte dumps).
-void PrintTo(const Malformed& m, std::ostream* os) { *os << m.name; }
+void PrintTo(const ColmapMalformed& m, std::ostream* os) { *os << m.name; }
 
-class ColmapReaderMalformed : public ::testing::TestWithParam<Malformed> {};
+class ColmapReaderMalformed : public ::testing::TestWithParam<ColmapMalformed> {};
 
 TEST_P(ColmapReaderMalformed, FailsNamingFileAndLine) {
-  const Malformed& m = GetParam();
+  const ColmapMalformed& m = GetParam();
   const fs::path dir = OneImageProject(m.cameras, m.images);
   test::ExpectInputError([&] { ReadBlock(dir); }, m.file, m.line, m.expect);
 }
@@ -126,18 +124,19 @@ const char kCam[] = "# comment\n1 PINHOLE 640 480 500 500 320 240\n";
 
 INSTANTIATE_TEST_SUITE_P(
     Cases, ColmapReaderMalformed,
-    ::testing::Values(Malformed{"UnknownModel", "1 FISHEYE_WEIRD 640 480 500 320 240\n", "",
-                                "cameras.txt", 1, "unsupported camera model 'FISHEYE_WEIRD'"},
-                      Malformed{"WrongParamCount", "1 PINHOLE 640 480 500 500 320\n", "",
-                                "cameras.txt", 1, "expected 8 fields"},
-                      Malformed{"BadQuaternion", kCam, "# images\n1 2 0 0 0 0 0 0 1 a.jpg\n\n",
-                                "images.txt", 2, "norm 2"},
-                      Malformed{"UnknownCamera", kCam, "1 1 0 0 0 0 0 0 9 a.jpg\n\n", "images.txt",
-                                1, "unknown CAMERA_ID 9"},
-                      Malformed{"ShortImageLine", kCam, "1 1 0 0 0 0 0 0 1\n\n", "images.txt", 1,
-                                "expected at least 10 fields"},
-                      Malformed{"NotANumber", kCam, "1 1 0 0 0 x 0 0 1 a.jpg\n\n", "images.txt", 1,
-                                "got 'x'"}),
+    ::testing::Values(ColmapMalformed{"UnknownModel", "1 FISHEYE_WEIRD 640 480 500 320 240\n", "",
+                                      "cameras.txt", 1, "unsupported camera model 'FISHEYE_WEIRD'"},
+                      ColmapMalformed{"WrongParamCount", "1 PINHOLE 640 480 500 500 320\n", "",
+                                      "cameras.txt", 1, "expected 8 fields"},
+                      ColmapMalformed{"BadQuaternion", kCam,
+                                      "# images\n1 2 0 0 0 0 0 0 1 a.jpg\n\n", "images.txt", 2,
+                                      "norm 2"},
+                      ColmapMalformed{"UnknownCamera", kCam, "1 1 0 0 0 0 0 0 9 a.jpg\n\n",
+                                      "images.txt", 1, "unknown CAMERA_ID 9"},
+                      ColmapMalformed{"ShortImageLine", kCam, "1 1 0 0 0 0 0 0 1\n\n", "images.txt",
+                                      1, "expected at least 10 fields"},
+                      ColmapMalformed{"NotANumber", kCam, "1 1 0 0 0 x 0 0 1 a.jpg\n\n",
+                                      "images.txt", 1, "got 'x'"}),
     [](const auto& p) { return p.param.name; });
 
 }  // namespace

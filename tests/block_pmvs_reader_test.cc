@@ -12,8 +12,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path HerzJesu() { return test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"; }
-
 std::string Name8(size_t i) {
   std::ostringstream s;
   s << std::setw(8) << std::setfill('0') << i;
@@ -38,8 +36,8 @@ fs::path WritePmvs(const Block& block, const fs::path& dir, double scale) {
 }
 
 TEST(PmvsReader, ReadsHerzJesuWrittenAsPmvs) {
-  SAPMVS_REQUIRE_PATH(HerzJesu());
-  const Block ref = ReadBlock(HerzJesu());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const Block ref = ReadBlock(test::HerzJesu());
   // VisualSFM writes P at arbitrary scale; a negative one flips the sign.
   const fs::path dir = WritePmvs(ref, test::ScratchDir(), -1e-3);
   EXPECT_EQ(DetectBlockFormat(dir), BlockFormat::kPmvs);
@@ -64,11 +62,11 @@ using Malformed = test::MalformedText;
 class PmvsReaderMalformed : public ::testing::TestWithParam<Malformed> {};
 
 TEST_P(PmvsReaderMalformed, FailsNamingFileAndLine) {
-  SAPMVS_REQUIRE_PATH(HerzJesu());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
   const fs::path dir = test::ScratchDir();
   fs::create_directories(dir / "txt");
   fs::create_directories(dir / "visualize");
-  fs::create_symlink(HerzJesu() / "images" / "0000.jpg", dir / "visualize" / "00000000.jpg");
+  fs::create_symlink(test::HerzJesu() / "images" / "0000.jpg", dir / "visualize" / "00000000.jpg");
   std::ofstream(dir / "txt" / "00000000.txt") << GetParam().text;
   test::ExpectInputError([&] { ReadBlock(dir); }, "00000000.txt", GetParam().line,
                          GetParam().expect);

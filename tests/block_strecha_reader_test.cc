@@ -11,11 +11,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path HerzJesu() { return test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"; }
-
 TEST(StrechaReader, ReadsHerzJesuP8) {
-  SAPMVS_REQUIRE_PATH(HerzJesu());
-  const Block block = ReadBlock(HerzJesu());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const Block block = ReadBlock(test::HerzJesu());
   EXPECT_EQ(block.format, "strecha");
   ASSERT_EQ(block.images.size(), 8u);
   for (const BlockImage& im : block.images) {
@@ -38,8 +36,8 @@ TEST(StrechaReader, ReadsHerzJesuP8) {
 }
 
 TEST(StrechaReader, SiftMatchesSatisfyTheEpipolarGeometry) {
-  SAPMVS_REQUIRE_PATH(HerzJesu());
-  const Block block = ReadBlock(HerzJesu());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const Block block = ReadBlock(test::HerzJesu());
   for (size_t i = 0; i + 1 < block.images.size(); ++i) {
     const BlockImage& a = block.images[i];
     const BlockImage& b = block.images[i + 1];

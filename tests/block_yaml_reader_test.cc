@@ -190,7 +190,7 @@ TEST(YamlReader, EveryOrientationTypeAndConventionGivesTheSameCameras) {
   }
 }
 
-struct Malformed {
+struct YamlMalformed {
   std::string name;
   std::string orientation_keys;
   std::string orientation;
@@ -201,13 +201,13 @@ struct Malformed {
 };
 
 // Keeps ctest's discovered test names stable (no byte dumps).
-void PrintTo(const Malformed& m, std::ostream* os) { *os << m.name; }
+void PrintTo(const YamlMalformed& m, std::ostream* os) { *os << m.name; }
 
-class YamlReaderMalformed : public ::testing::TestWithParam<Malformed> {};
+class YamlReaderMalformed : public ::testing::TestWithParam<YamlMalformed> {};
 
 TEST_P(YamlReaderMalformed, FailsNamingFileAndLine) {
   SAPMVS_REQUIRE_PATH(SharedDir() / "datasets/orthority_ngi_odm/ngi");
-  const Malformed m = GetParam();
+  const YamlMalformed m = GetParam();
   const fs::path dir = test::ScratchDir();
   const fs::path yaml = WriteBlock(dir, NgiYaml(m.orientation_keys, m.camera_keys), m.orientation);
   test::ExpectInputError([&] { ReadBlock(yaml); }, m.expect_file, m.expect_line, m.expect_text);
@@ -221,21 +221,21 @@ const std::string kOpk = "  angles: omega-phi-kappa\n  units: deg\n";
 INSTANTIATE_TEST_SUITE_P(
     Cases, YamlReaderMalformed,
     ::testing::Values(
-        Malformed{"TooFewFields", kOpk, kGoodLine + "3324c_2015_1004_05_0184_RGB 1 2 3 4 5\n", "",
-                  "orientation.txt", 2, "expected 7 fields"},
-        Malformed{"NotANumber", kOpk, "# header\n\n3324c_2015_1004_05_0182_RGB 1 2 3 x 5 6\n", "",
-                  "orientation.txt", 3, "got 'x'"},
-        Malformed{"NaN", kOpk, "3324c_2015_1004_05_0182_RGB 1 2 nan 4 5 6\n", "", "orientation.txt",
-                  1, "finite"},
-        Malformed{"UnknownImage", kOpk, kGoodLine + "no_such_image 1 2 3 4 5 6\n", "",
-                  "orientation.txt", 2, "no image for 'no_such_image'"},
-        Malformed{"UnknownUnit", "  angles: omega-phi-kappa\n  units: degs\n", kGoodLine, "",
-                  "block.yaml", 10, "unknown angle unit 'degs'"},
-        Malformed{"MissingUnits", "  angles: omega-phi-kappa\n", kGoodLine, "", "block.yaml", 8,
-                  "missing key 'units'"},
-        Malformed{"CameraWithoutPixelSize", kOpk, kGoodLine, "  focal_mm: 120\n", "block.yaml", 2,
-                  "needs pixel_um or sensor_mm"},
-        Malformed{
+        YamlMalformed{"TooFewFields", kOpk, kGoodLine + "3324c_2015_1004_05_0184_RGB 1 2 3 4 5\n",
+                      "", "orientation.txt", 2, "expected 7 fields"},
+        YamlMalformed{"NotANumber", kOpk, "# header\n\n3324c_2015_1004_05_0182_RGB 1 2 3 x 5 6\n",
+                      "", "orientation.txt", 3, "got 'x'"},
+        YamlMalformed{"NaN", kOpk, "3324c_2015_1004_05_0182_RGB 1 2 nan 4 5 6\n", "",
+                      "orientation.txt", 1, "finite"},
+        YamlMalformed{"UnknownImage", kOpk, kGoodLine + "no_such_image 1 2 3 4 5 6\n", "",
+                      "orientation.txt", 2, "no image for 'no_such_image'"},
+        YamlMalformed{"UnknownUnit", "  angles: omega-phi-kappa\n  units: degs\n", kGoodLine, "",
+                      "block.yaml", 10, "unknown angle unit 'degs'"},
+        YamlMalformed{"MissingUnits", "  angles: omega-phi-kappa\n", kGoodLine, "", "block.yaml", 8,
+                      "missing key 'units'"},
+        YamlMalformed{"CameraWithoutPixelSize", kOpk, kGoodLine, "  focal_mm: 120\n", "block.yaml",
+                      2, "needs pixel_um or sensor_mm"},
+        YamlMalformed{
             "BadDistortionTerm", kOpk, kGoodLine,
             "  fx: 833\n  fy: 833\n  cx: 319.5\n  cy: 575.5\n  distortion: {k1: 0.1, k9: 1}\n",
             "block.yaml", 8, "unknown distortion term 'k9'"}),

@@ -23,14 +23,14 @@ using Bytes = std::vector<uint8_t>;
 class LasExtraBytesTest : public test::ScratchTest {};
 
 template <typename T>
-T Field(const Bytes& b, size_t at) {
+T LeValue(const Bytes& b, size_t at) {
   T v{};
   EXPECT_LE(at + sizeof(T), b.size());
   if (at + sizeof(T) <= b.size()) std::memcpy(&v, b.data() + at, sizeof v);
   return v;
 }
 
-Bytes ReadBytes(const fs::path& path) {
+Bytes FileBytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
@@ -114,41 +114,41 @@ TEST_P(LasVersionsTest, ExtraBytesVlrFollowsTheSpecification) {
       {"score", "photo-consistency", LasExtraType::kFloat32, {0.5, 0.75, -0.25}},
       {"views", "", LasExtraType::kUint16, {3, 4, 300}}};
   WriteLas(path, Points(3), options, fields);
-  const Bytes b = ReadBytes(path);
+  const Bytes b = FileBytes(path);
   const size_t header = v12 ? 227 : 375;
   EXPECT_EQ(b[24], 1);
   EXPECT_EQ(b[25], v12 ? 2 : 4);
-  EXPECT_EQ(Field<uint16_t>(b, 94), header);
+  EXPECT_EQ(LeValue<uint16_t>(b, 94), header);
   EXPECT_EQ(b[104], v12 ? 2 : 7);
   const size_t base = v12 ? 26 : 36;
-  EXPECT_EQ(Field<uint16_t>(b, 105), base + 4 + 2);  // record length
+  EXPECT_EQ(LeValue<uint16_t>(b, 105), base + 4 + 2);  // record length
   // LAS 1.2 keeps the count in the legacy field, LAS 1.4 (format 7) in the
   // 64-bit one.
-  EXPECT_EQ(Field<uint32_t>(b, 107), v12 ? 3u : 0u);
+  EXPECT_EQ(LeValue<uint32_t>(b, 107), v12 ? 3u : 0u);
   if (!v12) {
-    EXPECT_EQ(Field<uint64_t>(b, 247), 3u);
+    EXPECT_EQ(LeValue<uint64_t>(b, 247), 3u);
   }
 
   // No CRS: the only VLR is the Extra Bytes one.
-  ASSERT_EQ(Field<uint32_t>(b, 100), 1u);
+  ASSERT_EQ(LeValue<uint32_t>(b, 100), 1u);
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(&b[header + 2])), "LASF_Spec");
-  EXPECT_EQ(Field<uint16_t>(b, header + 18), 4);
-  ASSERT_EQ(Field<uint16_t>(b, header + 20), 2 * 192);
+  EXPECT_EQ(LeValue<uint16_t>(b, header + 18), 4);
+  ASSERT_EQ(LeValue<uint16_t>(b, header + 20), 2 * 192);
   const size_t d0 = header + 54, d1 = d0 + 192;
-  EXPECT_EQ(Field<uint32_t>(b, 96), d1 + 192);  // offset to point data
-  EXPECT_EQ(b[d0 + 2], 9);                      // float
-  EXPECT_EQ(b[d0 + 3], 0b110);                  // min and max given
+  EXPECT_EQ(LeValue<uint32_t>(b, 96), d1 + 192);  // offset to point data
+  EXPECT_EQ(b[d0 + 2], 9);                        // float
+  EXPECT_EQ(b[d0 + 3], 0b110);                    // min and max given
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(&b[d0 + 4])), "score");
-  EXPECT_EQ(Field<double>(b, d0 + 64), -0.25);
-  EXPECT_EQ(Field<double>(b, d0 + 88), 0.75);
+  EXPECT_EQ(LeValue<double>(b, d0 + 64), -0.25);
+  EXPECT_EQ(LeValue<double>(b, d0 + 88), 0.75);
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(&b[d0 + 160])), "photo-consistency");
   EXPECT_EQ(b[d1 + 2], 3);  // unsigned short
   EXPECT_EQ(b[d1 + 3], 0);  // integer fields: no min or max
-  EXPECT_EQ(Field<double>(b, d1 + 64), 0.0);
+  EXPECT_EQ(LeValue<double>(b, d1 + 64), 0.0);
   // The third point's extra bytes, after its format's own.
   const size_t third = d1 + 192 + 2 * (base + 6);
-  EXPECT_EQ(Field<float>(b, third + base), -0.25f);
-  EXPECT_EQ(Field<uint16_t>(b, third + base + 4), 300);
+  EXPECT_EQ(LeValue<float>(b, third + base), -0.25f);
+  EXPECT_EQ(LeValue<uint16_t>(b, third + base + 4), 300);
   EXPECT_EQ(b.size(), third + base + 6);
 }
 
@@ -162,19 +162,19 @@ TEST_F(LasExtraBytesTest, Las12StoresAnEpsgCrsAsGeoTiffKeysAndWkt) {
   LasWriteOptions options;
   options.crs = "EPSG:32632";
   WriteLas(path, Points(2), options);
-  const Bytes b = ReadBytes(path);
-  ASSERT_EQ(Field<uint32_t>(b, 100), 2u);
-  EXPECT_EQ(Field<uint16_t>(b, 6), 0) << "no WKT bit before LAS 1.4";
+  const Bytes b = FileBytes(path);
+  ASSERT_EQ(LeValue<uint32_t>(b, 100), 2u);
+  EXPECT_EQ(LeValue<uint16_t>(b, 6), 0) << "no WKT bit before LAS 1.4";
   // The GeoKeyDirectory: {1, 1, 0, keys}, then {id, 0, 1, value} by id.
   const size_t v = 227;
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(&b[v + 2])), "LASF_Projection");
-  EXPECT_EQ(Field<uint16_t>(b, v + 18), 34735);
+  EXPECT_EQ(LeValue<uint16_t>(b, v + 18), 34735);
   const size_t keys = v + 54;
-  ASSERT_EQ(Field<uint16_t>(b, keys + 6), 3);
-  EXPECT_EQ(Field<uint16_t>(b, keys + 8), 1024);   // GTModelType
-  EXPECT_EQ(Field<uint16_t>(b, keys + 8 + 6), 1);  // projected
-  EXPECT_EQ(Field<uint16_t>(b, keys + 24), 3072);  // ProjectedCSType
-  EXPECT_EQ(Field<uint16_t>(b, keys + 24 + 6), 32632);
+  ASSERT_EQ(LeValue<uint16_t>(b, keys + 6), 3);
+  EXPECT_EQ(LeValue<uint16_t>(b, keys + 8), 1024);   // GTModelType
+  EXPECT_EQ(LeValue<uint16_t>(b, keys + 8 + 6), 1);  // projected
+  EXPECT_EQ(LeValue<uint16_t>(b, keys + 24), 3072);  // ProjectedCSType
+  EXPECT_EQ(LeValue<uint16_t>(b, keys + 24 + 6), 32632);
   EXPECT_NE(ReadLas(path).crs_wkt.find("32632"), std::string::npos);
 }
 
@@ -233,7 +233,7 @@ TEST_F(LasExtraBytesTest, BadFieldsAreRefusedBeforeAnythingIsWritten) {
 TEST_F(LasExtraBytesTest, AVlrDescribingMoreBytesThanTheRecordsHoldIsIgnored) {
   const fs::path path = dir_ / "mismatch.las";
   WriteLas(path, Points(3), {}, {{"f", "", LasExtraType::kFloat32, {1, 2, 3}}});
-  Bytes b = ReadBytes(path);
+  Bytes b = FileBytes(path);
   b[227 + 54 + 2] = 10;  // float -> double: 8 bytes described, 4 there
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), b.size());
   const LasCloud cloud = ReadLas(path, true);

@@ -30,14 +30,14 @@ class LasIoTest : public test::ScratchTest {};
 // Little-endian field access, written independently of las_io.cc so that the
 // tests check the bytes against the specification, not against themselves.
 template <typename T>
-T Field(const Bytes& b, size_t at) {
+T LeField(const Bytes& b, size_t at) {
   if (at + sizeof(T) > b.size()) throw std::out_of_range("field past the end of the file");
   T v;
   std::memcpy(&v, b.data() + at, sizeof v);
   return v;
 }
 template <typename T>
-void SetField(Bytes* b, size_t at, T v) {
+void SetLeField(Bytes* b, size_t at, T v) {
   if (at + sizeof(T) > b->size()) throw std::out_of_range("field past the end of the file");
   std::memcpy(b->data() + at, &v, sizeof v);
 }
@@ -169,24 +169,24 @@ TEST_F(LasIoTest, HeaderBytesFollowLas14Format7) {
   EXPECT_EQ(std::string(b.begin(), b.begin() + 4), "LASF");
   EXPECT_EQ(b[24], 1);
   EXPECT_EQ(b[25], 4);
-  EXPECT_EQ(Field<uint16_t>(b, 94), 375);  // header size
-  EXPECT_TRUE(Field<uint16_t>(b, 6) & (1 << 4)) << "WKT bit of the global encoding";
-  EXPECT_EQ(b[104], 7);                    // point format
-  EXPECT_EQ(Field<uint16_t>(b, 105), 36);  // record length
-  EXPECT_EQ(Field<uint32_t>(b, 107), 0u);  // legacy count: zero for formats 6-10
-  EXPECT_EQ(Field<uint64_t>(b, 247), 93u);
-  EXPECT_EQ(Field<uint32_t>(b, 243), 0u);  // no EVLRs
+  EXPECT_EQ(LeField<uint16_t>(b, 94), 375);  // header size
+  EXPECT_TRUE(LeField<uint16_t>(b, 6) & (1 << 4)) << "WKT bit of the global encoding";
+  EXPECT_EQ(b[104], 7);                      // point format
+  EXPECT_EQ(LeField<uint16_t>(b, 105), 36);  // record length
+  EXPECT_EQ(LeField<uint32_t>(b, 107), 0u);  // legacy count: zero for formats 6-10
+  EXPECT_EQ(LeField<uint64_t>(b, 247), 93u);
+  EXPECT_EQ(LeField<uint32_t>(b, 243), 0u);  // no EVLRs
   uint64_t by_return_sum = 0;
-  for (int r = 0; r < 15; ++r) by_return_sum += Field<uint64_t>(b, 255 + 8 * r);
+  for (int r = 0; r < 15; ++r) by_return_sum += LeField<uint64_t>(b, 255 + 8 * r);
   EXPECT_EQ(by_return_sum, 93u);
 
   // One VLR: LASF_Projection / 2112 carrying NUL-terminated WKT.
-  ASSERT_EQ(Field<uint32_t>(b, 100), 1u);
+  ASSERT_EQ(LeField<uint32_t>(b, 100), 1u);
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(&b[375 + 2])), "LASF_Projection");
-  EXPECT_EQ(Field<uint16_t>(b, 375 + 18), 2112);
-  const size_t vlr_length = Field<uint16_t>(b, 375 + 20);
+  EXPECT_EQ(LeField<uint16_t>(b, 375 + 18), 2112);
+  const size_t vlr_length = LeField<uint16_t>(b, 375 + 20);
   EXPECT_EQ(b[375 + 54 + vlr_length - 1], 0);
-  const size_t point_offset = Field<uint32_t>(b, 96);
+  const size_t point_offset = LeField<uint32_t>(b, 96);
   EXPECT_EQ(point_offset, 375 + 54 + vlr_length);
   // GDAL is no LAS reader, so the layout is checked by size.
   EXPECT_EQ(fs::file_size(path), point_offset + 93 * 36);
@@ -201,23 +201,24 @@ TEST_F(LasIoTest, HeaderBytesFollowLas14Format7) {
     const auto [in_lo, in_hi] = std::minmax_element(points.begin(), points.end(), less);
     const auto [out_lo, out_hi] =
         std::minmax_element(cloud.points.begin(), cloud.points.end(), less);
-    const double scale = Field<double>(b, 131 + 8 * a);
+    const double scale = LeField<double>(b, 131 + 8 * a);
     EXPECT_EQ(scale, 0.001);
-    EXPECT_EQ(Field<double>(b, 179 + 16 * a), coord(*out_hi)) << a;
-    EXPECT_EQ(Field<double>(b, 187 + 16 * a), coord(*out_lo)) << a;
-    EXPECT_NEAR(Field<double>(b, 179 + 16 * a), coord(*in_hi), scale / 2 + 1e-8) << a;
-    EXPECT_NEAR(Field<double>(b, 187 + 16 * a), coord(*in_lo), scale / 2 + 1e-8) << a;
+    EXPECT_EQ(LeField<double>(b, 179 + 16 * a), coord(*out_hi)) << a;
+    EXPECT_EQ(LeField<double>(b, 187 + 16 * a), coord(*out_lo)) << a;
+    EXPECT_NEAR(LeField<double>(b, 179 + 16 * a), coord(*in_hi), scale / 2 + 1e-8) << a;
+    EXPECT_NEAR(LeField<double>(b, 187 + 16 * a), coord(*in_lo), scale / 2 + 1e-8) << a;
     // The offset is a whole unit inside the data.
-    const double offset = Field<double>(b, 155 + 8 * a);
+    const double offset = LeField<double>(b, 155 + 8 * a);
     EXPECT_EQ(offset, std::round(offset));
     EXPECT_GE(offset, coord(*in_lo) - 0.5);
     EXPECT_LE(offset, coord(*in_hi) + 0.5);
   }
   // First point record, decoded by hand.
   const uint8_t* p = &b[point_offset];
-  const double x = Field<int32_t>(b, point_offset) * Field<double>(b, 131) + Field<double>(b, 155);
+  const double x =
+      LeField<int32_t>(b, point_offset) * LeField<double>(b, 131) + LeField<double>(b, 155);
   EXPECT_NEAR(x, points[0].x, 0.0005 + 1e-8);
-  EXPECT_EQ(Field<uint16_t>(b, point_offset + 30), points[0].r);
+  EXPECT_EQ(LeField<uint16_t>(b, point_offset + 30), points[0].r);
   EXPECT_EQ(p[14] & 0x0F, points[0].return_number);
   EXPECT_EQ(p[14] >> 4, points[0].number_of_returns);
   EXPECT_EQ(p[16], points[0].classification);
@@ -227,8 +228,8 @@ TEST_F(LasIoTest, WithoutCrsThereIsNoVlr) {
   const fs::path path = dir_ / "plain.las";
   WriteLas(path, RandomUtmPoints(7, 5), V14());
   const Bytes b = ReadBytes(path);
-  EXPECT_EQ(Field<uint32_t>(b, 100), 0u);
-  EXPECT_EQ(Field<uint32_t>(b, 96), 375u);
+  EXPECT_EQ(LeField<uint32_t>(b, 100), 0u);
+  EXPECT_EQ(LeField<uint32_t>(b, 96), 375u);
   EXPECT_EQ(b.size(), 375u + 7 * 36);
 }
 
@@ -327,34 +328,34 @@ Bytes BuildLas12(int format, const std::vector<LegacyPoint>& points, int extra) 
   std::memcpy(b.data(), "LASF", 4);
   b[24] = 1;
   b[25] = 2;
-  SetField<uint16_t>(&b, 94, 227);
-  SetField<uint32_t>(&b, 96, 227);
+  SetLeField<uint16_t>(&b, 94, 227);
+  SetLeField<uint32_t>(&b, 96, 227);
   b[104] = static_cast<uint8_t>(format);
-  SetField<uint16_t>(&b, 105, static_cast<uint16_t>(record));
-  SetField<uint32_t>(&b, 107, static_cast<uint32_t>(points.size()));
+  SetLeField<uint16_t>(&b, 105, static_cast<uint16_t>(record));
+  SetLeField<uint32_t>(&b, 107, static_cast<uint32_t>(points.size()));
   const double scale[3] = {0.01, 0.01, 0.001}, offset[3] = {431000, 5410000, 0};
   for (int a = 0; a < 3; ++a) {
-    SetField<double>(&b, 131 + 8 * a, scale[a]);
-    SetField<double>(&b, 155 + 8 * a, offset[a]);
+    SetLeField<double>(&b, 131 + 8 * a, scale[a]);
+    SetLeField<double>(&b, 155 + 8 * a, offset[a]);
   }
   for (size_t i = 0; i < points.size(); ++i) {
     const size_t at = 227 + i * record;
     const LegacyPoint& p = points[i];
-    SetField<int32_t>(&b, at, p.x);
-    SetField<int32_t>(&b, at + 4, p.y);
-    SetField<int32_t>(&b, at + 8, p.z);
-    SetField<uint16_t>(&b, at + 12, p.intensity);
+    SetLeField<int32_t>(&b, at, p.x);
+    SetLeField<int32_t>(&b, at + 4, p.y);
+    SetLeField<int32_t>(&b, at + 8, p.z);
+    SetLeField<uint16_t>(&b, at + 12, p.intensity);
     b[at + 14] = static_cast<uint8_t>(p.return_number | (p.number_of_returns << 3) | 0x40);
     b[at + 15] = p.class_byte;
     b[at + 16] = 0xF3;  // scan angle rank -13
     b[at + 17] = 0xAB;  // user data
-    SetField<uint16_t>(&b, at + 18, 4242);
-    if (format == 1 || format == 3) SetField<double>(&b, at + 20, 123456.789);
+    SetLeField<uint16_t>(&b, at + 18, 4242);
+    if (format == 1 || format == 3) SetLeField<double>(&b, at + 20, 123456.789);
     const size_t rgb = format == 2 ? 20 : 28;
     if (format >= 2) {
-      SetField<uint16_t>(&b, at + rgb, p.r);
-      SetField<uint16_t>(&b, at + rgb + 2, p.g);
-      SetField<uint16_t>(&b, at + rgb + 4, p.b);
+      SetLeField<uint16_t>(&b, at + rgb, p.r);
+      SetLeField<uint16_t>(&b, at + rgb + 2, p.g);
+      SetLeField<uint16_t>(&b, at + rgb + 4, p.b);
     }
     for (int e = 0; e < extra; ++e) b[at + base[format] + e] = 0xEE;
   }
@@ -422,11 +423,11 @@ TEST_F(LasIoTest, WktInAnEvlrIsRead) {
   const size_t start = b.size();
   b.resize(start + 60 + text.size() + 1, 0);
   std::memcpy(&b[start + 2], "LASF_Projection", 15);
-  SetField<uint16_t>(&b, start + 18, 2112);
-  SetField<uint64_t>(&b, start + 20, text.size() + 1);
+  SetLeField<uint16_t>(&b, start + 18, 2112);
+  SetLeField<uint64_t>(&b, start + 20, text.size() + 1);
   std::memcpy(&b[start + 60], text.data(), text.size());
-  SetField<uint64_t>(&b, 235, start);
-  SetField<uint32_t>(&b, 243, 1);
+  SetLeField<uint64_t>(&b, 235, start);
+  SetLeField<uint32_t>(&b, 243, 1);
   WriteBytes(path, b);
   const LasCloud cloud = ReadLas(path);
   EXPECT_EQ(cloud.points.size(), 7u);
@@ -467,7 +468,7 @@ TEST_F(LasMalformedTest, TruncatedHeader) {
 
 TEST_F(LasMalformedTest, HeaderSizeTooSmall) {
   Bytes b = Valid();
-  SetField<uint16_t>(&b, 94, 227);
+  SetLeField<uint16_t>(&b, 94, 227);
   const fs::path path = Write(b);
   ExpectInputError([&] { ReadLas(path); }, path, "expected at least 375");
 }
@@ -481,7 +482,7 @@ TEST_F(LasMalformedTest, TruncatedPoints) {
 
 TEST_F(LasMalformedTest, PointCountBeyondFileSize) {
   Bytes b = Valid();
-  SetField<uint64_t>(&b, 247, uint64_t{1} << 60);
+  SetLeField<uint64_t>(&b, 247, uint64_t{1} << 60);
   const fs::path path = Write(b);
   ExpectInputError([&] { ReadLas(path); }, path, "room for 93");
 }
@@ -502,7 +503,7 @@ TEST_F(LasMalformedTest, UnknownPointFormat) {
 
 TEST_F(LasMalformedTest, RecordTooShortForItsFormat) {
   Bytes b = Valid();
-  SetField<uint16_t>(&b, 105, 30);
+  SetLeField<uint16_t>(&b, 105, 30);
   const fs::path path = Write(b);
   ExpectInputError([&] { ReadLas(path); }, path, "too short for format 7");
 }
@@ -520,7 +521,7 @@ TEST_F(LasMalformedTest, VlrRunningIntoThePoints) {
   const fs::path valid = dir_ / "crs.las";
   WriteLas(valid, RandomUtmPoints(3, 4), options);
   Bytes b = ReadBytes(valid);
-  SetField<uint16_t>(&b, 375 + 20, 60000);
+  SetLeField<uint16_t>(&b, 375 + 20, 60000);
   const fs::path path = Write(b);
   ExpectInputError([&] { ReadLas(path); }, path, "variable length record 1 of 1");
 }

@@ -107,6 +107,8 @@ bool OpenClRequired() {
   return env && std::string(env) == "1";
 }
 
+std::filesystem::path HerzJesu() { return SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"; }
+
 std::string Slurp(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());

@@ -20,6 +20,8 @@ namespace sapmvs::test {
 std::filesystem::path TestDir();
 // ../shared beside the checkout (as in CI); SAPMVS_SHARED_DIR overrides it.
 std::filesystem::path SharedDir();
+// Strecha's Herz-Jesu-P8 under SharedDir().
+std::filesystem::path HerzJesu();
 // The bytes of `path`; "" when it cannot be read.
 std::string Slurp(const std::filesystem::path& path);
 // A fresh, empty directory under the system temp dir, unique per test.

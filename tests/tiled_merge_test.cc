@@ -31,13 +31,13 @@ using test::Slurp;
 // (40 m apart, so neighbours overlap by 20 m) with 0.5 m points jittered
 // off the grid, on gentle relief, scores random: the cross-group duplicates
 // the merge resolves, across every tile border.
-struct Block {
+struct GroupGrid {
   std::vector<PointCloud> clouds;
   std::vector<Eigen::Vector2d> centers;
 };
 
-Block MakeBlock() {
-  Block b;
+GroupGrid MakeGroupGrid() {
+  GroupGrid b;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> jitter(-0.2, 0.2), score(0.5, 1.0);
   for (int gy = 0; gy < 3; ++gy) {
@@ -65,7 +65,7 @@ Block MakeBlock() {
   return b;
 }
 
-std::vector<MergeSource> Sources(const Block& b) {
+std::vector<MergeSource> Sources(const GroupGrid& b) {
   std::vector<MergeSource> s;
   for (size_t g = 0; g < b.clouds.size(); ++g) {
     s.push_back({[&b, g](const PointFilter& keep) {
@@ -83,13 +83,14 @@ std::vector<MergeSource> Sources(const Block& b) {
   return s;
 }
 
-PointCloud GlobalMerge(const Block& b, const MergeOptions& o, MergeStats* st) {
+PointCloud GlobalMerge(const GroupGrid& b, const MergeOptions& o, MergeStats* st) {
   std::vector<GroupCloud> parts;
   for (size_t g = 0; g < b.clouds.size(); ++g) parts.push_back({&b.clouds[g], b.centers[g]});
   return MergeGroupClouds(parts, o, st);
 }
 
-PointCloud TiledMerge(const Block& b, const MergeOptions& o, MergeStats* st, MergeLayout* layout) {
+PointCloud TiledMerge(const GroupGrid& b, const MergeOptions& o, MergeStats* st,
+                      MergeLayout* layout) {
   PointCloud all;
   *st = MergeInTiles(
       Sources(b), o,
@@ -111,7 +112,7 @@ std::set<Key> Keys(const PointCloud& c) {
 }
 
 TEST(TiledMergeTest, OneTileIsTheGlobalMerge) {
-  const Block b = MakeBlock();
+  const GroupGrid b = MakeGroupGrid();
   MergeOptions o;
   o.radius = 0.5;
   o.tile_points = 1000000;  // more than the block's 129,600
@@ -133,7 +134,7 @@ TEST(TiledMergeTest, OneTileIsTheGlobalMerge) {
 }
 
 TEST(TiledMergeTest, ManyTilesDifferOnlyNearBorders) {
-  const Block b = MakeBlock();
+  const GroupGrid b = MakeGroupGrid();
   MergeOptions o;
   o.radius = 0.5;
   o.tile_points = 8000;  // tiles of about 15 m: dozens, every group cut
@@ -159,7 +160,7 @@ TEST(TiledMergeTest, ManyTilesDifferOnlyNearBorders) {
 }
 
 TEST(TiledMergeTest, ChunkedWritersGiveTheBytesOfOnePiece) {
-  const Block b = MakeBlock();
+  const GroupGrid b = MakeGroupGrid();
   const PointCloud& cloud = b.clouds[4];
   const std::filesystem::path dir = ScratchDir();
   WritePly(dir / "whole.ply", cloud);
@@ -220,7 +221,7 @@ TEST(TiledMergeTest, ChunkedWritersGiveTheBytesOfOnePiece) {
 }
 
 TEST(TiledMergeTest, BandedDsmIsTheWholeDsm) {
-  const Block b = MakeBlock();
+  const GroupGrid b = MakeGroupGrid();
   std::vector<GroupCloud> parts;
   for (size_t g = 0; g < b.clouds.size(); ++g) parts.push_back({&b.clouds[g], b.centers[g]});
   MergeOptions mo;
