@@ -185,7 +185,7 @@ TEST(ColmapBinaryReader, MatchesTextModelOfTheSameBlock) {
 }
 
 TEST(ColmapBinaryReader, MatchesTextModelOfHerzJesu) {
-  const fs::path herz = test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8";
+  const fs::path herz = test::HerzJesu();
   SAPMVS_REQUIRE_PATH(herz);
   const Block ref = ReadBlock(herz, NoSizeCheck());
   const Block t = ReadBlock(Project(ref, true, false, "text"), NoSizeCheck());

@@ -73,9 +73,8 @@ TEST(BlockGeometry, NgiDemGivesTheExpectedGsd) {
 }
 
 TEST(BlockGeometry, HerzJesuTiePointsFindTheFacade) {
-  SAPMVS_REQUIRE_PATH(test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8");
-  const BlockGeometry g = EstimateBlockGeometry(
-      ReadBlock(test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"));
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const BlockGeometry g = EstimateBlockGeometry(ReadBlock(test::HerzJesu()));
   EXPECT_EQ(g.source, SurfaceSource::kTiePoints);
   EXPECT_FALSE(g.aerial);
   EXPECT_EQ(g.num_valid, 8);

@@ -20,7 +20,7 @@ TEST(BlockFormat, DetectedFromThePathGiven) {
   EXPECT_EQ(DetectBlockFormat(odm), BlockFormat::kOpenSfm);
   EXPECT_EQ(DetectBlockFormat(odm / "opensfm"), BlockFormat::kOpenSfm);
   EXPECT_EQ(DetectBlockFormat(odm / "opensfm" / "reconstruction.json"), BlockFormat::kOpenSfm);
-  const fs::path hj = SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8";
+  const fs::path hj = test::HerzJesu();
   EXPECT_EQ(DetectBlockFormat(hj), BlockFormat::kStrecha);
   EXPECT_EQ(DetectBlockFormat(hj / "gt_dense_cameras"), BlockFormat::kStrecha);
   EXPECT_EQ(DetectBlockFormat(hj / "gt_dense_cameras" / "0003.jpg.camera"), BlockFormat::kStrecha);
@@ -58,14 +58,12 @@ TEST(BlockFormat, MissingOrUnknownPathsSayWhatWasExpected) {
 }
 
 TEST(BlockFormat, ForcedFormatOverridesDetection) {
-  SAPMVS_REQUIRE_PATH(SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8");
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
   BlockReadOptions options;
   options.format = BlockFormat::kColmap;
-  EXPECT_THROW(ReadBlock(SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8", options), Error);
+  EXPECT_THROW(ReadBlock(test::HerzJesu(), options), Error);
   options.format = BlockFormat::kStrecha;
-  EXPECT_EQ(
-      ReadBlock(SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8", options).images.size(),
-      8u);
+  EXPECT_EQ(ReadBlock(test::HerzJesu(), options).images.size(), 8u);
 }
 
 TEST(BlockReadOptions, CheckRejectsAMissingImageFolder) {

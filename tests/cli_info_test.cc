@@ -35,9 +35,8 @@ TEST(CliInfo, NgiBlock) {
 }
 
 TEST(CliInfo, HerzJesu) {
-  SAPMVS_REQUIRE_PATH(test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8");
-  const auto r =
-      RunCli("info " + (test::SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8").string());
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const auto r = RunCli("info " + test::HerzJesu().string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("images         8\n"), std::string::npos) << r.out;
   EXPECT_EQ(Count(r.out, "3072x2048"), 9) << r.out;

@@ -23,13 +23,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-SimulateOptions Tiny(const fs::path& out, double scale = 1.0, uint64_t seed = 1) {
-  SimulateOptions o;
-  o.preset = "tiny";
+SimulateOptions Tiny(const fs::path& out, double scale = 1.0, int seed = 1) {
+  SimulateOptions o = test::SimulatedOptions("tiny", seed, scale);
   o.out = out;
-  o.seed = seed;
-  o.scale = scale;
-  o.quiet = true;
   return o;
 }
 
