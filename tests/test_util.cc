@@ -297,9 +297,17 @@ const Features& SiftFeatures(const std::filesystem::path& path) {
   static std::map<std::string, Features> cache;
   auto it = cache.find(path.string());
   if (it != cache.end()) return it->second;
-  const cv::Mat grey = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  // SIFT at half size: OpenCV first doubles the image, so at full size it
+  // builds its pyramid from 4x the pixels, and on a 3072x2048 image that
+  // is seconds of page faults per image. Keypoints map back to full-size
+  // pixels (centres at integers), so callers keep full-size units.
+  const cv::Mat full = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+  cv::Mat grey;
+  cv::resize(full, grey, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
   Features f;
   cv::SIFT::create(4000)->detectAndCompute(grey, cv::noArray(), f.keypoints, f.descriptors);
+  for (cv::KeyPoint& k : f.keypoints)
+    k.pt = (k.pt + cv::Point2f(0.5f, 0.5f)) * 2.0f - cv::Point2f(0.5f, 0.5f);
   return cache.emplace(path.string(), std::move(f)).first->second;
 }
 
