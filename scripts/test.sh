@@ -8,9 +8,8 @@
 #   scripts/test.sh --opencl [ctest args...]     only the tests that need an
 #       OpenCL device (label `opencl`), in build/
 #   scripts/test.sh --sanitize [ctest args...]   AddressSanitizer + UBSan build
-#       in build-sanitize/ (gcc; -O1, the test files -O0; unity batches;
-#       tests/CMakeLists.txt)
-#       of the tests that need no OpenCL device
+#       in build-sanitize/ (gcc; -O1, the test files -O0, unity batches as in
+#       every build; tests/CMakeLists.txt) of the tests that need no OpenCL device
 #       (label `host`, see tests/CMakeLists.txt); any report fails its test.
 #
 # Labels: host/opencl (needs a device or not), fast/e2e (e.g. `-L fast`).

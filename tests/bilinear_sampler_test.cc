@@ -20,7 +20,7 @@ using test::ClTest;
 
 class BilinearSamplerTest : public ClTest {};
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kMaxPixel = 100.0f;  // Pixel values lie in [-kMaxPixel, kMaxPixel].
 
@@ -29,8 +29,8 @@ using test::NearAbsRel;
 // float32 bilinear interpolation rounds a handful of times on values up to
 // kMaxPixel; 4 epsilons of that is about 6x the worst error seen on PoCL and
 // leaves room for FMA contraction on other devices.
-constexpr double kAbsTol = 4.0 * FLT_EPSILON * kMaxPixel;
-constexpr double kRelTol = 4.0 * FLT_EPSILON;
+constexpr double kSampleAbsTol = 4.0 * FLT_EPSILON * kMaxPixel;
+constexpr double kSampleRelTol = 4.0 * FLT_EPSILON;
 
 // An image whose padding (beyond width in each row) is NaN, so a read of the
 // padding would turn into a NaN mismatch.
@@ -42,7 +42,7 @@ struct TestImage {
 TestImage RandomImage(int width, int height, int row_pitch, uint32_t seed) {
   TestImage image;
   image.view.layout = {width, height, row_pitch};
-  image.pixels.assign(image.view.layout.RequiredElements(), kNaN);
+  image.pixels.assign(image.view.layout.RequiredElements(), kNaNf);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> value(-kMaxPixel, kMaxPixel);
   for (int r = 0; r < height; ++r) {
@@ -53,8 +53,8 @@ TestImage RandomImage(int width, int height, int row_pitch, uint32_t seed) {
   return image;
 }
 
-float Above(float v) { return std::nextafter(v, kInf); }
-float Below(float v) { return std::nextafter(v, -kInf); }
+float NextUp(float v) { return std::nextafter(v, kInf); }
+float NextDown(float v) { return std::nextafter(v, -kInf); }
 
 // Random positions around and inside the image, every position on or one ulp
 // either side of each border, and non-finite coordinates.
@@ -69,12 +69,12 @@ std::vector<Eigen::Vector2f> TestPoints(int width, int height, uint32_t seed) {
   std::vector<Eigen::Vector2f> points;
   for (int i = 0; i < 2000; ++i) points.emplace_back(any_x(rng), any_y(rng));
   for (int i = 0; i < 2000; ++i) points.emplace_back(in_x(rng), in_y(rng));
-  const std::vector<float> border_x = {-0.0f,    0.0f,     Above(0.0f), Below(0.0f),
-                                       -0.5f,    Above(w), w,           Below(w),
-                                       w + 0.5f, w + 1.0f, Below(1.0f)};
-  const std::vector<float> border_y = {-0.0f,    0.0f,     Above(0.0f), Below(0.0f),
-                                       -0.5f,    Above(h), h,           Below(h),
-                                       h + 0.5f, h + 1.0f, Below(1.0f)};
+  const std::vector<float> border_x = {-0.0f,         0.0f, NextUp(0.0f), NextDown(0.0f), -0.5f,
+                                       NextUp(w),     w,    NextDown(w),  w + 0.5f,       w + 1.0f,
+                                       NextDown(1.0f)};
+  const std::vector<float> border_y = {-0.0f,         0.0f, NextUp(0.0f), NextDown(0.0f), -0.5f,
+                                       NextUp(h),     h,    NextDown(h),  h + 0.5f,       h + 1.0f,
+                                       NextDown(1.0f)};
   for (float x : border_x) {
     for (float y : border_y) points.emplace_back(x, y);  // Corners.
     for (int i = 0; i < 20; ++i) points.emplace_back(x, in_y(rng));
@@ -82,7 +82,7 @@ std::vector<Eigen::Vector2f> TestPoints(int width, int height, uint32_t seed) {
   for (float y : border_y) {
     for (int i = 0; i < 20; ++i) points.emplace_back(in_x(rng), y);
   }
-  for (float bad : {kNaN, kInf, -kInf}) {
+  for (float bad : {kNaNf, kInf, -kInf}) {
     points.emplace_back(bad, 0.0f);
     points.emplace_back(0.0f, bad);
     points.emplace_back(bad, bad);
@@ -119,7 +119,7 @@ TEST_P(BilinearSamplerSizeTest, MatchesDoubleReference) {
   ASSERT_EQ(values.size(), points.size());
   int num_nan = 0;
   for (size_t i = 0; i < points.size(); ++i) {
-    EXPECT_TRUE(NearAbsRel(values[i], expected[i], kAbsTol, kRelTol))
+    EXPECT_TRUE(NearAbsRel(values[i], expected[i], kSampleAbsTol, kSampleRelTol))
         << "at (" << points[i].x() << ", " << points[i].y() << "), point " << i;
     num_nan += std::isnan(expected[i]) ? 1 : 0;
   }
@@ -218,7 +218,7 @@ TEST_F(BilinearSamplerTest, RejectsBadInputBeforeEnqueue) {
 
 TEST(BilinearReferenceTest, KnownValuesAndBorderPolicy) {
   // 3x2 image, row pitch 4 (padding NaN).
-  const std::vector<float> pixels = {0, 1, 2, kNaN, 10, 11, 12, kNaN};
+  const std::vector<float> pixels = {0, 1, 2, kNaNf, 10, 11, 12, kNaNf};
   const FloatImageView image{pixels.data(), {3, 2, 4}};
   EXPECT_DOUBLE_EQ(BilinearSampleReference(image, 0.5, 0.5), 5.5);
   EXPECT_DOUBLE_EQ(BilinearSampleReference(image, 1.25, 0.0), 1.25);

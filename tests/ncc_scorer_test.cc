@@ -130,7 +130,7 @@ void PrintTo(const ScoreCase& c, std::ostream* out) {
        << ", sigma_color " << c.sigma_color;
 }
 
-std::string CaseName(const ::testing::TestParamInfo<ScoreCase>& info) {
+std::string ScoreCaseName(const ::testing::TestParamInfo<ScoreCase>& info) {
   return "patch" + std::to_string(info.param.patch_size) + "_" + std::to_string(info.param.width) +
          "x" + std::to_string(info.param.height) +
          (info.param.sigma_color > 0
@@ -176,7 +176,7 @@ INSTANTIATE_TEST_SUITE_P(NccSizes, NccScorerCaseTest,
                                            ScoreCase{7, 161, 123, 36, 3.0},
                                            ScoreCase{5, 97, 211, 37, 1.0},
                                            ScoreCase{15, 201, 161, 38, 3.0}),
-                         CaseName);
+                         ScoreCaseName);
 
 class NccScorerTest : public ClTest {};
 

@@ -37,11 +37,11 @@ using test::PlaneScene;
 
 // Scores, device vs reference: as ncc_scorer_test (float32 sums of up to 441
 // samples; a wrong sample or axis moves the NCC by 1e-2 or more).
-constexpr double kAbsTol = 1e-4;
-constexpr double kRelTol = 1e-4;
+constexpr double kNccAbsTol = 1e-4;
+constexpr double kNccRelTol = 1e-4;
 // Pixels from an image's valid region within which float32 and double
 // positions may fall on different sides of the border (ncc_scorer_test).
-constexpr double kBorderAmbiguity = 1e-3;
+constexpr double kNccBorderAmbiguity = 1e-3;
 // Refinement, device vs reference: as patch_refiner_test. Float32 can flip a
 // late near-tie of the search, so the final score is compared with a
 // tolerance; where every decision had a margin above kSafeMargin the two
@@ -54,8 +54,8 @@ constexpr double kAngleTol = 1e-4;  // Radians.
 // Patches on or near the ground under random pixels of random reference
 // images, half of them within 6 px of a border (either side), normals tilted
 // up to about 25 degrees; each paired with every image.
-void RandomBatch(const PlaneScene& scene, int num_patches, uint32_t seed,
-                 std::vector<NccPatch>* patches, std::vector<NccPair>* pairs) {
+void RandomBackendBatch(const PlaneScene& scene, int num_patches, uint32_t seed,
+                        std::vector<NccPatch>* patches, std::vector<NccPair>* pairs) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const int num_images = static_cast<int>(scene.cameras.size());
@@ -117,7 +117,7 @@ TEST(ReferencePatchKernelsTest, IsTheDoubleReferenceInFloat) {
   kernels->SetGroup(scene.group);
   std::vector<NccPatch> patches;
   std::vector<NccPair> pairs;
-  RandomBatch(scene, 60, 72, &patches, &pairs);
+  RandomBackendBatch(scene, 60, 72, &patches, &pairs);
   NccScorerOptions so;
   so.patch_size = 9;
   so.sigma_color = 3.0;
@@ -211,7 +211,7 @@ TEST_P(PatchKernelsBackendsTest, ScoresAgree) {
   const PlaneScene scene = MakePlaneScene(4, c.width, c.height, c.seed);
   std::vector<NccPatch> patches;
   std::vector<NccPair> pairs;
-  RandomBatch(scene, 150, c.seed + 1, &patches, &pairs);
+  RandomBackendBatch(scene, 150, c.seed + 1, &patches, &pairs);
   NccScorerOptions so;
   so.patch_size = c.patch_size;
   so.sigma_color = c.sigma_color;
@@ -229,11 +229,11 @@ TEST_P(PatchKernelsBackendsTest, ScoresAgree) {
   int valid = 0, nan = 0, ambiguous = 0;
   double worst = 0;
   for (size_t i = 0; i < got.size(); ++i) {
-    if (std::abs(margin[i]) < kBorderAmbiguity && std::isnan(got[i]) != std::isnan(want[i])) {
+    if (std::abs(margin[i]) < kNccBorderAmbiguity && std::isnan(got[i]) != std::isnan(want[i])) {
       ++ambiguous;
       continue;
     }
-    EXPECT_TRUE(NearAbsRel(got[i], want[i], kAbsTol, kRelTol)) << "pair " << i;
+    EXPECT_TRUE(NearAbsRel(got[i], want[i], kNccAbsTol, kNccRelTol)) << "pair " << i;
     if (std::isnan(want[i])) {
       ++nan;
     } else {
