@@ -2,6 +2,9 @@
 // binary as a user runs it. None of these needs an OpenCL device.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -77,6 +80,27 @@ TEST(CliExitCodes, HelpAndVersionExit0OnStdout) {
   for (const std::string flag : {"--threads", "--verbose", "--log", "--quiet"}) {
     EXPECT_NE(h.out.find(flag), std::string::npos) << h.out;
   }
+}
+
+// Built from a git checkout of its own, --version names a commit of that
+// checkout ("unknown" is for a tarball or a copy inside another repository).
+TEST(CliExitCodes, VersionNamesTheCommitOfItsCheckout) {
+  const std::filesystem::path source = std::filesystem::weakly_canonical(test::TestDir() / "..");
+  const std::string git = "git -C '" + source.string() + "' ";
+  std::string top;
+  if (FILE* f = popen((git + "rev-parse --show-toplevel 2>/dev/null").c_str(), "r")) {
+    char line[4096];
+    if (std::fgets(line, sizeof line, f)) top = line;
+    pclose(f);
+  }
+  while (!top.empty() && top.back() == '\n') top.pop_back();
+  if (top.empty() || std::filesystem::weakly_canonical(top) != source) {
+    GTEST_SKIP() << source << " is not the top of a git checkout";
+  }
+  const auto v = RunCli("--version");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(v.out, m, std::regex(R"(\(commit ([0-9a-f]{7,40})\))"))) << v.out;
+  EXPECT_EQ(std::system((git + "cat-file -e " + m[1].str() + "^{commit}").c_str()), 0) << m[1];
 }
 
 TEST(CliGlobalFlags, BadThreadCountIsOneLineNamingIt) {
