@@ -2,8 +2,6 @@
 // binary as a user runs it. None of these needs an OpenCL device.
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -18,6 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::CountLines;
 using test::RunCli;
+using test::RunCommand;
 
 // One line on stderr that begins "sapmvs: " and contains each of `names`,
 // exit code 1, nothing on stdout.
@@ -87,12 +86,7 @@ TEST(CliExitCodes, HelpAndVersionExit0OnStdout) {
 TEST(CliExitCodes, VersionNamesTheCommitOfItsCheckout) {
   const std::filesystem::path source = std::filesystem::weakly_canonical(test::TestDir() / "..");
   const std::string git = "git -C '" + source.string() + "' ";
-  std::string top;
-  if (FILE* f = popen((git + "rev-parse --show-toplevel 2>/dev/null").c_str(), "r")) {
-    char line[4096];
-    if (std::fgets(line, sizeof line, f)) top = line;
-    pclose(f);
-  }
+  std::string top = RunCommand(git + "rev-parse --show-toplevel").out;
   while (!top.empty() && top.back() == '\n') top.pop_back();
   if (top.empty() || std::filesystem::weakly_canonical(top) != source) {
     GTEST_SKIP() << source << " is not the top of a git checkout";
@@ -100,7 +94,7 @@ TEST(CliExitCodes, VersionNamesTheCommitOfItsCheckout) {
   const auto v = RunCli("--version");
   std::smatch m;
   ASSERT_TRUE(std::regex_search(v.out, m, std::regex(R"(\(commit ([0-9a-f]{7,40})\))"))) << v.out;
-  EXPECT_EQ(std::system((git + "cat-file -e " + m[1].str() + "^{commit}").c_str()), 0) << m[1];
+  EXPECT_EQ(RunCommand(git + "cat-file -e " + m[1].str() + "^{commit}").exit_code, 0) << m[1];
 }
 
 TEST(CliGlobalFlags, BadThreadCountIsOneLineNamingIt) {

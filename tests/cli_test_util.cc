@@ -14,29 +14,26 @@
 
 namespace sapmvs::test {
 
-CliResult RunCli(const std::string& args, const std::string& env) {
+CliResult RunCommand(const std::string& command) {
   // Not ScratchDir(): that would wipe the calling test's own files.
   static int calls = 0;
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() /
       ("sapmvs_cli_" + std::to_string(::getpid()) + "_" + std::to_string(++calls));
   std::filesystem::create_directories(dir);
-  const std::string cmd = env + (env.empty() ? "" : " ") + SAPMVS_CLI_PATH + " " + args + " > " +
-                          (dir / "out.txt").string() + " 2> " + (dir / "err.txt").string() +
-                          " < /dev/null";
+  const std::string cmd = command + " > " + (dir / "out.txt").string() + " 2> " +
+                          (dir / "err.txt").string() + " < /dev/null";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  auto slurp = [](const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
-  r.out = slurp(dir / "out.txt");
-  r.err = slurp(dir / "err.txt");
+  r.out = Slurp(dir / "out.txt");
+  r.err = Slurp(dir / "err.txt");
   std::filesystem::remove_all(dir);
   return r;
+}
+
+CliResult RunCli(const std::string& args, const std::string& env) {
+  return RunCommand(env + (env.empty() ? "" : " ") + SAPMVS_CLI_PATH + " " + args);
 }
 
 SharedRunResult SharedRun(const std::filesystem::path& block, const std::string& args) {

@@ -14,6 +14,10 @@ struct CliResult {
   std::string err;  // stderr
 };
 
+// Runs a shell command line, stdin from /dev/null, capturing stdout and
+// stderr.
+CliResult RunCommand(const std::string& command);
+
 // Runs `env sapmvs args` through the shell; `env` is a prefix such as
 // "OCL_ICD_VENDORS=/tmp/none" (may be empty).
 CliResult RunCli(const std::string& args, const std::string& env = "");
