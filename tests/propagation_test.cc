@@ -4,10 +4,17 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <set>
 #include <utility>
 
+#include <opencv2/core.hpp>
+
+#include "match/group_data.h"
+#include "match/patch_engine.h"
+#include "match/reference_patch_kernels.h"
+#include "plane_scene.h"
 #include "sapmvs/block/camera.h"
 
 namespace sapmvs {
@@ -208,6 +215,57 @@ TEST(WindowPixels, AMatchedEdgeLineIsABarrier) {
   const auto got = WindowPixels(grey, 20, 20, 21, 3.0, 0.3, diagonal);
   ASSERT_FALSE(got.empty());
   for (const auto& [x, y] : got) EXPECT_LT(x + y, 44) << x << ", " << y;
+}
+
+// The points are reserved once, for as many as the reference cells can hold
+// (one per pixel, one per cell in pmvs mode), so that the waves append to
+// the array without copying it.
+TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
+  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
+  MatchGroupData group;
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    MatchImage image;
+    image.camera = scene.cameras[i];
+    image.grey = cv::Mat(97, 121, CV_32F, scene.pixels[i].data());
+    for (size_t j = 0; j < scene.cameras.size(); ++j) {
+      if (j != i) image.views.push_back(static_cast<int>(j));
+    }
+    group.images.push_back(image);
+  }
+  group.ncc = scene.group;
+  std::vector<SeedFeature> seeds;
+  for (const test::PlaneStart& s : test::PerturbedStarts(scene, 6, 0.2, 2.0, {25.0, 20.0}, 5)) {
+    SeedFeature f;
+    f.image = 0;
+    f.uv = scene.cameras[0].Project(s.center);
+    PatchCandidate c;
+    c.center = s.center;
+    c.normal = s.normal;
+    c.ref = 0;
+    f.candidates.push_back(c);
+    seeds.push_back(f);
+  }
+  const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
+  for (const MatchMode mode : {MatchMode::kSapmvs, MatchMode::kPmvs}) {
+    SCOPED_TRACE(mode == MatchMode::kPmvs ? "pmvs" : "sapmvs");
+    MatcherOptions options;
+    options.mode = mode;
+    options.max_angle_deg = 5.0;  // the cameras are a few metres apart at 40 m
+    options.max_waves = 3;
+    const size_t cs = static_cast<size_t>(options.cell_size);
+    size_t cells = 0;
+    for (const Camera& camera : scene.cameras) {
+      cells += ((camera.width() + cs - 1) / cs) * ((camera.height() + cs - 1) / cs);
+    }
+    PatchEngine engine(*kernels, group, options);
+    Propagator propagator(group, options, engine);
+    EXPECT_EQ(propagator.points().capacity(), cells * (mode == MatchMode::kPmvs ? 1 : cs * cs));
+    const DensePoint* array = propagator.points().data();
+    propagator.RunSeeds(seeds);
+    propagator.RunWaves({});
+    EXPECT_GT(propagator.points().size(), seeds.size());
+    EXPECT_EQ(propagator.points().data(), array);
+  }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numeric>
 
 namespace sapmvs {
@@ -96,6 +97,23 @@ Propagator::Propagator(const MatchGroupData& group, const MatcherOptions& option
     grids_.push_back(std::move(g));
   }
   seed_depths_.resize(group_.images.size());
+  // A point lies in a reference cell its patch owns, one per pixel (one
+  // centre per cell in pmvs mode), so the cells bound the points. Reserving
+  // the bound once replaces growing by copies: on `city` those copies, and
+  // the page faults of each new array, were half of the main thread's work
+  // in the waves, with the other core idle, and held the old array beside
+  // the new. An array this large is mapped (MemoryUse), so only the pages
+  // written take memory. A cell freed by Prune can hold more, and a system
+  // that commits every page it lends may refuse the address space: Emit
+  // grows the array then.
+  const size_t per_cell =
+      options_.mode == MatchMode::kPmvs ? 1 : static_cast<size_t>(cs) * static_cast<size_t>(cs);
+  size_t bound = 0;
+  for (const Grid& g : grids_) bound += g.owner.size() * per_cell;
+  try {
+    points_.reserve(bound);
+  } catch (const std::bad_alloc&) {
+  }
 }
 
 bool Propagator::IsBarrier(int image, int x, int y, const AcceptedPatch& patch) const {
