@@ -40,7 +40,7 @@ std::vector<int32_t> ScanAll(const std::vector<float>& xyz, const std::vector<do
 }
 
 void ExpectSameAsScan(const std::vector<float>& xyz, const std::vector<double>& radius, int k) {
-  const std::vector<int32_t> got = NearestWithin(xyz, radius, k);
+  const auto got = NearestWithin(xyz, radius, k);
   const std::vector<int32_t> want = ScanAll(xyz, radius, k);
   ASSERT_EQ(got.size(), want.size());
   long differ = 0;
@@ -84,7 +84,7 @@ TEST(NearestWithin, TiesGoByIndexAndTheRadiusIsInclusive) {
     radius.push_back(rep == 0 ? 0.0 : 1.5);
   }
   for (const int k : {1, 4, 9}) ExpectSameAsScan(xyz, radius, k);
-  const std::vector<int32_t> nn = NearestWithin(xyz, radius, 4);
+  const auto nn = NearestWithin(xyz, radius, 4);
   // (0, 0), radius 1: (1, 0) and (0, 1) at distance 1, the smaller index first.
   EXPECT_EQ(nn[0], 1);
   EXPECT_EQ(nn[1], 11);

@@ -193,11 +193,11 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // distances below, and its neighbour radius: neighbour_radius footprints
   // along its plane's slope, so that a surface seen obliquely, whose points
   // lie further apart, keeps as many neighbours as one seen face-on.
-  std::vector<double> footprint(alive.size());
+  UninitializedVector<double> footprint(alive.size());
   // nn[a * k + j]: the j-th nearest neighbour of point a within a's radius,
   // or -1.
   const int k = kNeighbours;
-  std::vector<int32_t> nn;
+  UninitializedVector<int32_t> nn;
   {
     std::vector<float> xyz(alive.size() * 3);
     std::vector<double> radius(alive.size());

@@ -71,7 +71,7 @@ class ColumnGrid {
     nw_ = static_cast<int>(std::min(std::floor((hi[w_] - lo[w_]) / cell_) + 1, 1e9));
 
     // Counting sort by column, then each column by (cell along it, index).
-    std::vector<int32_t> column(n);
+    UninitializedVector<int32_t> column(n);
     start_.assign(static_cast<size_t>(nu_) * nv_ + 1, 0);
     for (size_t a = 0; a < n; ++a) {
       const float* p = &xyz[3 * a];
@@ -154,6 +154,7 @@ class ColumnGrid {
       }
     }
     for (size_t j = 0; j < best->size(); ++j) out[j] = (*best)[j].second;
+    std::fill(out + best->size(), out + k, -1);
   }
 
   // The e-th point in column order.
@@ -169,14 +170,14 @@ class ColumnGrid {
   int u_ = 0, v_ = 1, w_ = 2;
   double cell_ = 1;
   int nu_ = 1, nv_ = 1, nw_ = 1;
-  std::vector<uint32_t> start_;  // column c's entries: [start_[c], start_[c + 1])
-  std::vector<Entry> entries_;
+  std::vector<uint32_t> start_;         // column c's entries: [start_[c], start_[c + 1])
+  UninitializedVector<Entry> entries_;  // every one written by the constructor
 };
 
 }  // namespace
 
-std::vector<int32_t> NearestWithin(std::vector<float> xyz, const std::vector<double>& radius,
-                                   int k) {
+UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
+                                           const std::vector<double>& radius, int k) {
   const size_t n = radius.size();
   if (xyz.size() != 3 * n) {
     throw Error("NearestWithin: expected 3 coordinates per radius (" + std::to_string(xyz.size()) +
@@ -206,7 +207,9 @@ std::vector<int32_t> NearestWithin(std::vector<float> xyz, const std::vector<dou
   // times their size at k = 16, is only allocated once the input is gone:
   // this is the peak of the filter, which is the peak of a group's run.
   std::vector<float>().swap(xyz);  // `xyz = {}` would keep the capacity
-  std::vector<int32_t> out(n * static_cast<size_t>(k), -1);
+  // Each row is written whole by the thread that searches its point, which
+  // so takes its pages' first faults.
+  UninitializedVector<int32_t> out(n * static_cast<size_t>(k));
 
 #pragma omp parallel
   {
