@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <cstring>
+#include <fstream>
 #include <memory>
 
 namespace sapmvs {
@@ -70,6 +73,27 @@ TEST(MemoryUse, LargeBlocksGoBackToTheSystemWhenFreed) {
   const double held = CurrentRssBytes();
   block.reset();
   EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
+}
+
+// An address-space limit (a batch system's h_vmem) counts every reserved
+// page: under one, reserving costs what writing would.
+TEST(MemoryUse, UnwrittenMemoryIsNotFreeUnderAnAddressSpaceLimit) {
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
+  if (saved.rlim_cur == RLIM_INFINITY) {
+    std::ifstream f("/proc/sys/vm/overcommit_memory");
+    int mode = -1;
+    if (!(f >> mode)) GTEST_SKIP() << "this system does not say how it overcommits (/proc)";
+    EXPECT_EQ(UnwrittenMemoryIsFree(), mode != 2) << "vm.overcommit_memory = " << mode;
+  }
+  // The largest finite limit: nothing this process maps can fail under it.
+  rlimit limited = saved;
+  limited.rlim_cur = RLIM_INFINITY - 1;
+  if (saved.rlim_max != RLIM_INFINITY) limited.rlim_cur = saved.rlim_max;
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
+  const bool free_under_limit = UnwrittenMemoryIsFree();
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  EXPECT_FALSE(free_under_limit);
 }
 
 }  // namespace

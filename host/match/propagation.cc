@@ -3,6 +3,7 @@
 #include "match/footprint.h"
 #include "match/ncc_score_reference.h"
 #include "match/plane_refit.h"
+#include "sapmvs/util/memory_use.h"
 #include "sapmvs/util/parallel_for.h"
 
 #include <algorithm>
@@ -103,16 +104,18 @@ Propagator::Propagator(const MatchGroupData& group, const MatcherOptions& option
   // the page faults of each new array, were half of the main thread's work
   // in the waves, with the other core idle, and held the old array beside
   // the new. An array this large is mapped (MemoryUse), so only the pages
-  // written take memory. A cell freed by Prune can hold more, and a system
-  // that commits every page it lends may refuse the address space: Emit
-  // grows the array then.
+  // written take memory, unless an address-space limit or strict overcommit
+  // counts the whole reservation: there, and where a cell freed by Prune
+  // holds more, Emit grows the array.
   const size_t per_cell =
       options_.mode == MatchMode::kPmvs ? 1 : static_cast<size_t>(cs) * static_cast<size_t>(cs);
   size_t bound = 0;
   for (const Grid& g : grids_) bound += g.owner.size() * per_cell;
-  try {
-    points_.reserve(bound);
-  } catch (const std::bad_alloc&) {
+  if (UnwrittenMemoryIsFree()) {
+    try {
+      points_.reserve(bound);
+    } catch (const std::bad_alloc&) {
+    }
   }
 }
 

@@ -59,6 +59,14 @@ void ReturnLargeBlocksToSystem() {
 #endif
 }
 
+bool UnwrittenMemoryIsFree() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur != RLIM_INFINITY) return false;
+  std::ifstream f("/proc/sys/vm/overcommit_memory");
+  int mode = -1;
+  return static_cast<bool>(f >> mode) && mode != 2;
+}
+
 void ReleaseFreeMemory() {
 #if defined(__GLIBC__)
   malloc_trim(0);

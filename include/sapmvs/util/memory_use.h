@@ -36,4 +36,11 @@ void ReleaseFreeMemory();
 // library has no such setting.
 void ReturnLargeBlocksToSystem();
 
+// Whether address space reserved and never written costs nothing: true
+// unless the process's address space is limited (RLIMIT_AS, as a batch
+// system's h_vmem sets it) or the system commits every page it lends
+// (vm.overcommit_memory = 2), where a reservation counts in full. False where
+// the system does not say (no /proc).
+bool UnwrittenMemoryIsFree();
+
 }  // namespace sapmvs
