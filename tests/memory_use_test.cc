@@ -75,6 +75,30 @@ TEST(MemoryUse, LargeBlocksGoBackToTheSystemWhenFreed) {
   EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
 }
 
+// Inside the scope a freed 8 MiB block stays resident for the next one;
+// at its end it goes back, and so do blocks freed after it.
+TEST(MemoryUse, ScopedHeapReuseKeepsFreedBlocksUntilItEnds) {
+  if (CurrentRssBytes() <= 0) GTEST_SKIP() << "this system does not report the RSS";
+  if (kSanitizerAllocator) {
+    GTEST_SKIP() << "the address sanitizer's allocator keeps freed memory in its quarantine";
+  }
+  ReturnLargeBlocksToSystem();
+  constexpr size_t kMedium = 8u << 20;
+  double held = 0;
+  {
+    const ScopedHeapReuse reuse;
+    auto block = TouchedBlock(kMedium);
+    held = CurrentRssBytes();
+    block.reset();
+    EXPECT_GE(CurrentRssBytes(), held - 0.1 * kMedium);
+  }
+  EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
+  auto block = TouchedBlock(kMedium);
+  held = CurrentRssBytes();
+  block.reset();
+  EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
+}
+
 // An address-space limit (a batch system's h_vmem) counts every reserved
 // page: under one, reserving costs what writing would.
 TEST(MemoryUse, UnwrittenMemoryIsNotFreeUnderAnAddressSpaceLimit) {

@@ -11,6 +11,7 @@
 
 #include "sapmvs/block/image_io.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/memory_use.h"
 #include "sapmvs/util/parallel_for.h"
 
 namespace sapmvs {
@@ -209,6 +210,8 @@ std::vector<TiePoint> TriangulateTiePoints(const Block& block, const TiePointOpt
   if (const std::string p = o.Problem(); !p.empty())
     throw Error("tie point options: expected " + p);
   const int n = static_cast<int>(block.images.size());
+  // Before the features, so that they are freed before it trims the heap.
+  const ScopedHeapReuse reuse;
   std::vector<ImageFeatures> images(n);
   std::vector<int> with_files;
   for (int i = 0; i < n; ++i) {

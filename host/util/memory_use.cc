@@ -27,6 +27,12 @@ double ProcStatusBytes(const std::string& name) {
   return 0;
 }
 
+// ReturnLargeBlocksToSystem's threshold; ScopedHeapReuse's, glibc's largest
+// (HEAP_MAX_SIZE / 2 on 64-bit systems); glibc's default trim threshold.
+constexpr int kLargeBlock = 2 << 20;
+constexpr int kReuseUpTo = 32 << 20;
+constexpr int kDefaultTrimThreshold = 128 << 10;
+
 // The process's peak before the last reset (ResetPeakRss).
 std::atomic<double> peak_before_reset{0};
 
@@ -55,7 +61,23 @@ bool ResetPeakRss() {
 
 void ReturnLargeBlocksToSystem() {
 #if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 2 << 20);
+  mallopt(M_MMAP_THRESHOLD, kLargeBlock);
+#endif
+}
+
+ScopedHeapReuse::ScopedHeapReuse() {
+#if defined(__GLIBC__)
+  // A free chunk above the trim threshold at the heap's top goes back too.
+  mallopt(M_TRIM_THRESHOLD, kReuseUpTo);
+  mallopt(M_MMAP_THRESHOLD, kReuseUpTo);
+#endif
+}
+
+ScopedHeapReuse::~ScopedHeapReuse() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, kLargeBlock);
+  mallopt(M_TRIM_THRESHOLD, kDefaultTrimThreshold);
+  malloc_trim(0);
 #endif
 }
 
