@@ -99,25 +99,32 @@ TEST(MemoryUse, ScopedHeapReuseKeepsFreedBlocksUntilItEnds) {
   EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
 }
 
-// An address-space limit (a batch system's h_vmem) counts every reserved
-// page: under one, reserving costs what writing would.
-TEST(MemoryUse, UnwrittenMemoryIsNotFreeUnderAnAddressSpaceLimit) {
-  rlimit saved{};
-  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
-  if (saved.rlim_cur == RLIM_INFINITY) {
+// An address-space limit (a batch system's h_vmem) or a data limit
+// (ulimit -d) counts every reserved page: under one, reserving costs what
+// writing would.
+TEST(MemoryUse, UnwrittenMemoryIsNotFreeUnderAnAddressSpaceOrDataLimit) {
+  rlimit as{}, data{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &as), 0);
+  ASSERT_EQ(getrlimit(RLIMIT_DATA, &data), 0);
+  if (as.rlim_cur == RLIM_INFINITY && data.rlim_cur == RLIM_INFINITY) {
     std::ifstream f("/proc/sys/vm/overcommit_memory");
     int mode = -1;
     if (!(f >> mode)) GTEST_SKIP() << "this system does not say how it overcommits (/proc)";
     EXPECT_EQ(UnwrittenMemoryIsFree(), mode != 2) << "vm.overcommit_memory = " << mode;
   }
-  // The largest finite limit: nothing this process maps can fail under it.
-  rlimit limited = saved;
-  limited.rlim_cur = RLIM_INFINITY - 1;
-  if (saved.rlim_max != RLIM_INFINITY) limited.rlim_cur = saved.rlim_max;
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &limited), 0);
-  const bool free_under_limit = UnwrittenMemoryIsFree();
-  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
-  EXPECT_FALSE(free_under_limit);
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    SCOPED_TRACE(resource == RLIMIT_AS ? "RLIMIT_AS" : "RLIMIT_DATA");
+    rlimit saved{};
+    ASSERT_EQ(getrlimit(resource, &saved), 0);
+    // The largest finite limit: nothing this process maps can fail under it.
+    rlimit limited = saved;
+    limited.rlim_cur = RLIM_INFINITY - 1;
+    if (saved.rlim_max != RLIM_INFINITY) limited.rlim_cur = saved.rlim_max;
+    ASSERT_EQ(setrlimit(resource, &limited), 0);
+    const bool free_under_limit = UnwrittenMemoryIsFree();
+    ASSERT_EQ(setrlimit(resource, &saved), 0);
+    EXPECT_FALSE(free_under_limit);
+  }
 }
 
 }  // namespace

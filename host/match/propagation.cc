@@ -104,9 +104,9 @@ Propagator::Propagator(const MatchGroupData& group, const MatcherOptions& option
   // the page faults of each new array, were half of the main thread's work
   // in the waves, with the other core idle, and held the old array beside
   // the new. An array this large is mapped (MemoryUse), so only the pages
-  // written take memory, unless an address-space limit or strict overcommit
-  // counts the whole reservation: there, and where a cell freed by Prune
-  // holds more, Emit grows the array.
+  // written take memory, unless an address-space or data limit or strict
+  // overcommit counts the whole reservation: there, and where a cell freed
+  // by Prune holds more, Emit grows the array.
   const size_t per_cell =
       options_.mode == MatchMode::kPmvs ? 1 : static_cast<size_t>(cs) * static_cast<size_t>(cs);
   size_t bound = 0;

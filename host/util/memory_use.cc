@@ -82,8 +82,12 @@ ScopedHeapReuse::~ScopedHeapReuse() {
 }
 
 bool UnwrittenMemoryIsFree() {
-  rlimit limit{};
-  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur != RLIM_INFINITY) return false;
+  // Linux counts private writable mappings against the data limit too
+  // (since 4.7), reserved or written.
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    rlimit limit{};
+    if (getrlimit(resource, &limit) != 0 || limit.rlim_cur != RLIM_INFINITY) return false;
+  }
   std::ifstream f("/proc/sys/vm/overcommit_memory");
   int mode = -1;
   return static_cast<bool>(f >> mode) && mode != 2;
