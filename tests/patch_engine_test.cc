@@ -31,21 +31,6 @@ using test::PlaneScene;
 
 constexpr double kPiRad = 3.14159265358979323846;
 
-// The scene as a match group: every image matched with all the others.
-MatchGroupData GroupOf(const PlaneScene& scene) {
-  MatchGroupData group;
-  for (size_t i = 0; i < scene.cameras.size(); ++i) {
-    MatchImage image;
-    image.camera = scene.cameras[i];
-    for (size_t j = 0; j < scene.cameras.size(); ++j) {
-      if (j != i) image.views.push_back(static_cast<int>(j));
-    }
-    group.images.push_back(image);
-  }
-  group.ncc = scene.group;  // points into scene's pixels, which outlive it
-  return group;
-}
-
 double Footprint(const Camera& camera, const Eigen::Vector3d& x) {
   return camera.Depth(x) / camera.intrinsics().MeanFocal();
 }
@@ -85,7 +70,7 @@ class PatchEngineTest : public ClTest {
 // a degree or two, or the border sub-windows fail threshold.
 TEST_F(PatchEngineTest, FlatGroundGrowsToTheLargestSizeFromATiltedStart) {
   const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
-  const MatchGroupData group = GroupOf(scene);
+  const MatchGroupData group = test::MatchGroupOf(scene);
   MatcherOptions options;  // sapmvs mode, sizes 21, 15, 11, 7
   ASSERT_EQ(options.adaptive_sizes.front(), 21);
   // The scene's cameras are a few metres apart at 40 m: growth needs a view
@@ -178,7 +163,7 @@ int VariantsWithin(const std::vector<Options>& launched, const std::vector<Optio
 // and the 21 x 21 variants (and would the others for seeds that stop between).
 TEST_F(PatchEngineTest, LaunchesOnlyTheVariantsPreparedForIt) {
   const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
-  const MatchGroupData group = GroupOf(scene);
+  const MatchGroupData group = test::MatchGroupOf(scene);
   MatcherOptions options;
   options.max_angle_deg = 5.0;  // as above
   for (const MatchMode mode : {MatchMode::kSapmvs, MatchMode::kPmvs}) {
@@ -203,7 +188,7 @@ TEST_F(PatchEngineTest, LaunchesOnlyTheVariantsPreparedForIt) {
 // rejected candidates are spread over both halves.
 TEST_F(PatchEngineTest, ALargeBatchGetsTheResultsItsPiecesGetAlone) {
   const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
-  const MatchGroupData group = GroupOf(scene);
+  const MatchGroupData group = test::MatchGroupOf(scene);
   MatcherOptions options;
   options.max_angle_deg = 5.0;  // as above, so that patches grow
   const std::vector<PatchCandidate> good = TiltedSeeds(scene, 400, 1.0, 6.0, 101);
@@ -247,7 +232,7 @@ TEST_F(PatchEngineTest, ALargeBatchGetsTheResultsItsPiecesGetAlone) {
 // faces away from the reference image are never scored.
 TEST_F(PatchEngineTest, RejectsSeedsWithTooFewViewsOrFacingAway) {
   const PlaneScene scene = MakePlaneScene(4, 201, 161, 93);
-  const MatchGroupData group = GroupOf(scene);
+  const MatchGroupData group = test::MatchGroupOf(scene);
   MatcherOptions options;
   {
     PatchEngine engine(NewKernels(), group, options);
@@ -268,7 +253,7 @@ TEST_F(PatchEngineTest, RejectsSeedsWithTooFewViewsOrFacingAway) {
 // is accepted only thanks to them.
 TEST_F(PatchEngineTest, ViewOnlyImagesOnlyFillUpToMinImageNum) {
   const PlaneScene scene = MakePlaneScene(5, 201, 161, 97);
-  MatchGroupData group = GroupOf(scene);
+  MatchGroupData group = test::MatchGroupOf(scene);
   group.images[3].reference = group.images[4].reference = false;
   const std::vector<PatchCandidate> seeds = TiltedSeeds(scene, 6, 0.0, 0.0, 98);
   auto view_only = [](const AcceptedPatch& a) {
@@ -312,7 +297,7 @@ TEST_F(PatchEngineTest, ViewOnlyImagesOnlyFillUpToMinImageNum) {
 TEST(SelectViewsTest, OwnImagesComeBeforeViewOnlyOnes) {
   const PlaneScene strip = MakePlaneScene(10, 201, 161, 99, 1.0);
   for (const int view_only : {2, 3}) {
-    MatchGroupData group = GroupOf(strip);
+    MatchGroupData group = test::MatchGroupOf(strip);
     for (MatchImage& im : group.images) im.depth = 40.0;
     for (int i = 1; i <= view_only; ++i) group.images[i].reference = false;
     SelectViews(MatcherOptions(), &group);
@@ -339,7 +324,7 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
   ASSERT_EQ(options.max_angle_deg, 10.0);
   const double base = 40.0 * std::tan(4.0 * kPiRad / 180.0);
   const PlaneScene strip = MakePlaneScene(5, 201, 161, 96, base);
-  MatchGroupData group = GroupOf(strip);
+  MatchGroupData group = test::MatchGroupOf(strip);
   for (MatchImage& im : group.images) im.depth = 40.0;
   SelectViews(options, &group);
   EXPECT_EQ(group.images[0].views.size(), 4u);  // none dropped for being narrow
@@ -376,7 +361,7 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
     }
   }
   const PlaneScene narrow = MakePlaneScene(5, 201, 161, 96, 40.0 * std::tan(0.5 * kPiRad / 180.0));
-  const MatchGroupData narrow_group = GroupOf(narrow);
+  const MatchGroupData narrow_group = test::MatchGroupOf(narrow);
   PatchEngine engine(NewKernels(), narrow_group, options);
   for (const auto& r : engine.Evaluate(TiltedSeeds(narrow, 8, 0.0, 0.0, 97))) EXPECT_FALSE(r);
   // The same seeds pass once max_angle allows the pairs' 1 to 2 degrees.

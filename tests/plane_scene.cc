@@ -65,6 +65,20 @@ Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv) {
   return camera.center() - (camera.center().z() / d.z()) * d;
 }
 
+MatchGroupData MatchGroupOf(const PlaneScene& scene) {
+  MatchGroupData group;
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    MatchImage image;
+    image.camera = scene.cameras[i];
+    for (size_t j = 0; j < scene.cameras.size(); ++j) {
+      if (j != i) image.views.push_back(static_cast<int>(j));
+    }
+    group.images.push_back(image);
+  }
+  group.ncc = scene.group;
+  return group;
+}
+
 std::vector<PlaneStart> PerturbedStarts(const PlaneScene& scene, int count, double depth_offset,
                                         double tilt_deg, const Eigen::Vector2d& spread,
                                         uint32_t seed) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "device/ncc_scorer.h"
+#include "match/group_data.h"
 #include "sapmvs/block/camera.h"
 
 namespace sapmvs::test {
@@ -33,6 +34,10 @@ struct PlaneScene {
 // at 40 m, that far apart, image 0 in the middle (0, -b, +b, -2b, ...).
 PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed,
                           double strip_base = 0);
+
+// The scene as a match group: every image matched with all the others. The
+// group's kernel views point into the scene's pixels, which must outlive it.
+MatchGroupData MatchGroupOf(const PlaneScene& scene);
 
 // Ground point (z = 0) seen at pixel `uv` of `camera`.
 Eigen::Vector3d GroundAt(const Camera& camera, const Eigen::Vector2d& uv);

@@ -223,20 +223,14 @@ TEST(WindowPixels, AMatchedEdgeLineIsABarrier) {
 // the array without copying it.
 TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
   if (!UnwrittenMemoryIsFree()) {
-    GTEST_SKIP() << "an address-space limit or strict overcommit: the points are not reserved";
+    GTEST_SKIP()
+        << "an address-space or data limit, or strict overcommit: the points are not reserved";
   }
   test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
-  MatchGroupData group;
-  for (size_t i = 0; i < scene.cameras.size(); ++i) {
-    MatchImage image;
-    image.camera = scene.cameras[i];
-    image.grey = cv::Mat(97, 121, CV_32F, scene.pixels[i].data());
-    for (size_t j = 0; j < scene.cameras.size(); ++j) {
-      if (j != i) image.views.push_back(static_cast<int>(j));
-    }
-    group.images.push_back(image);
+  MatchGroupData group = test::MatchGroupOf(scene);
+  for (size_t i = 0; i < group.images.size(); ++i) {
+    group.images[i].grey = cv::Mat(97, 121, CV_32F, scene.pixels[i].data());  // for the emission
   }
-  group.ncc = scene.group;
   std::vector<SeedFeature> seeds;
   for (const test::PlaneStart& s : test::PerturbedStarts(scene, 6, 0.2, 2.0, {25.0, 20.0}, 5)) {
     SeedFeature f;

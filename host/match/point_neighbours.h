@@ -21,10 +21,10 @@ namespace sapmvs {
 // For every point a of `xyz` (x, y, z of point a at 3a..3a+2): the indices of
 // at most `k` other points b whose squared distance, summed in float in x, y,
 // z order, is at most float(radius[a]^2), nearest first (ties by index);
-// row a is out[a * k .. a * k + k), padded with -1 (every slot is written). Throws Error when the
-// sizes disagree, k < 1, a radius is negative or not finite, or there are
-// more than 2^31 - 1 points. `xyz` is taken by value so that a caller that
-// moves it in frees it before the output is allocated.
+// row a is out[a * k .. a * k + k), padded with -1 (every slot is
+// written). Throws Error when the sizes disagree, k < 1, a radius is
+// negative or not finite, or there are more than 2^31 - 1 points. `xyz` is taken by value so that a
+// caller that moves it in frees it before the output is allocated.
 UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
                                            const std::vector<double>& radius, int k);
 

@@ -74,11 +74,11 @@ ScopedHeapReuse::ScopedHeapReuse() {
 }
 
 ScopedHeapReuse::~ScopedHeapReuse() {
+  ReturnLargeBlocksToSystem();
 #if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, kLargeBlock);
   mallopt(M_TRIM_THRESHOLD, kDefaultTrimThreshold);
-  malloc_trim(0);
 #endif
+  ReleaseFreeMemory();
 }
 
 bool UnwrittenMemoryIsFree() {

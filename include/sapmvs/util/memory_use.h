@@ -55,9 +55,9 @@ class ScopedHeapReuse {
 // Whether address space reserved and never written costs nothing: true
 // unless the process's address space or data is limited (RLIMIT_AS, as a
 // batch system's h_vmem sets it; RLIMIT_DATA, ulimit -d) or the system
-// commits every page it lends
-// (vm.overcommit_memory = 2), where a reservation counts in full. False where
-// the system does not say (no /proc).
+// commits every page it lends (vm.overcommit_memory = 2), where a
+// reservation counts in full. False where the system does not say (no
+// /proc).
 bool UnwrittenMemoryIsFree();
 
 }  // namespace sapmvs
