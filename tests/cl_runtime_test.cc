@@ -269,6 +269,40 @@ TEST_F(ClRuntimeTest, ProgramCacheKeyedByOptions) {
                std::logic_error);
 }
 
+TEST_F(ClRuntimeTest, ProgramsBuiltOnSeveralThreadsAreCachedOncePerKey) {
+  // Each thread asks for the same three keys in its own order, so threads
+  // miss the same key at once and build it twice; one program per key stays,
+  // and every thread gets that one.
+  ClContext fresh(context().device(), /*profile=*/false);
+  constexpr int kThreads = 6;
+  constexpr int kKeys = 3;
+  std::vector<std::vector<const ClProgram*>> got(kThreads, std::vector<const ClProgram*>(kKeys));
+  std::vector<std::string> errors(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      try {
+        for (int j = 0; j < kKeys; ++j) {
+          const int k = (t + j) % kKeys;
+          got[t][k] = &fresh.ProgramFromSource("iota_test", kIotaSource,
+                                               {{"SCALE", std::to_string(k + 1)}});
+        }
+      } catch (const std::exception& e) {
+        errors[t] = e.what();
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int t = 0; t < kThreads; ++t) ASSERT_EQ(errors[t], "") << "thread " << t;
+  EXPECT_EQ(fresh.NumCachedPrograms(), static_cast<size_t>(kKeys));
+  for (int k = 0; k < kKeys; ++k) {
+    const ClProgram* kept =
+        &fresh.ProgramFromSource("iota_test", kIotaSource, {{"SCALE", std::to_string(k + 1)}});
+    EXPECT_EQ(kept->options(), "-cl-std=CL1.2 -D SCALE=" + std::to_string(k + 1));
+    for (int t = 0; t < kThreads; ++t) EXPECT_EQ(got[t][k], kept) << "thread " << t << " key " << k;
+  }
+}
+
 TEST_F(ClRuntimeTest, BrokenKernelThrowsProgramBuildErrorWithLog) {
   const size_t before = context().NumCachedPrograms();
   const std::string source =

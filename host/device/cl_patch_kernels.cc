@@ -1,9 +1,14 @@
 #include "device/cl_patch_kernels.h"
 
+#include <algorithm>
+#include <atomic>
 #include <exception>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
+#include <system_error>
+#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -11,6 +16,7 @@
 #include "device/ncc_scorer.h"
 #include "device/patch_refiner.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/thread_count.h"
 
 namespace sapmvs {
 namespace {
@@ -68,19 +74,38 @@ class ClPatchKernels : public PatchKernels {
   void Prepare(const std::vector<NccScorerOptions>& scorers,
                const std::vector<PatchRefinerOptions>& refiners) override {
     // The context caches each program for the scorers and refiners that
-    // later launches make; these are only built to fill that cache.
+    // later launches make; these are only built to fill that cache, on
+    // several threads: NVIDIA's driver took 1 s or more per program on a
+    // cold cache, one after the other (Herz-Jesu-P8's first run on an H200).
+    std::vector<std::function<void()>> builds;
     for (const NccScorerOptions& o : scorers) {
-      try {
-        NccScorer scorer(context_, o);
-      } catch (const std::exception&) {  // the launch reports it
-      }
+      builds.emplace_back([this, o] { NccScorer scorer(context_, o); });
     }
     for (const PatchRefinerOptions& o : refiners) {
+      builds.emplace_back([this, o] { PatchRefiner refiner(context_, o); });
+    }
+    std::atomic<size_t> next{0};
+    const auto work = [&] {
+      for (size_t i; (i = next.fetch_add(1)) < builds.size();) {
+        try {
+          builds[i]();
+        } catch (const std::exception&) {  // the launch reports it
+        }
+      }
+    };
+    // MatchGroup's thread loads the images meanwhile: one of the host's
+    // threads fewer (so none more on two cores).
+    const size_t cores = static_cast<size_t>(std::max(2, HostThreadCount()));
+    std::vector<std::thread> threads;
+    for (size_t t = 1; t < std::min(builds.size(), cores - 1); ++t) {
       try {
-        PatchRefiner refiner(context_, o);
-      } catch (const std::exception&) {  // the launch reports it
+        threads.emplace_back(work);
+      } catch (const std::system_error&) {  // fewer threads, same builds
+        break;
       }
     }
+    work();
+    for (std::thread& t : threads) t.join();
   }
 
   bool ConcurrentLaunches() const override { return true; }

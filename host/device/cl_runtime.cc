@@ -550,6 +550,7 @@ ClContext& ClContext::operator=(ClContext&& other) noexcept {
     queues_ = std::move(other.queues_);
     leased_ = other.leased_;
     mutex_ = std::move(other.mutex_);
+    programs_mutex_ = std::move(other.programs_mutex_);
     programs_ = std::move(other.programs_);
   }
   return *this;
@@ -578,13 +579,24 @@ const ClProgram& ClContext::ProgramFromSource(std::string_view name, std::string
 const ClProgram& ClContext::CachedProgram(std::string_view name, const BuildOptions& defines,
                                           std::optional<std::string_view> source) {
   CacheKey key{device_.id, std::string(name), defines.Render()};
-  if (const auto it = programs_.find(key); it != programs_.end()) {
-    if (source && std::hash<std::string_view>{}(*source) != it->second.source_hash) {
+  const auto cached = [&](size_t source_hash) -> const ClProgram* {
+    const auto it = programs_.find(key);
+    if (it == programs_.end()) return nullptr;
+    if (source && source_hash != it->second.source_hash) {
       throw std::logic_error("OpenCL program name \"" + std::string(name) +
                              "\" reused for a different source");
     }
-    return *it->second.program;
+    return it->second.program.get();
+  };
+  const size_t given_hash = source ? std::hash<std::string_view>{}(*source) : 0;
+  {
+    std::lock_guard<std::mutex> lock(*programs_mutex_);
+    if (const ClProgram* program = cached(given_hash)) return *program;
   }
+  // Built outside the lock: a GPU driver's compiler takes a second or more
+  // per program on a cold cache, and the variants build on several threads
+  // (PatchKernels::Prepare). Two threads missing the same key both build;
+  // the first to finish is kept.
   std::string loaded;
   if (!source) {
     loaded = ProgramSource(name);
@@ -594,6 +606,8 @@ const ClProgram& ClContext::CachedProgram(std::string_view name, const BuildOpti
   entry.source_hash = std::hash<std::string_view>{}(*source);
   entry.program = std::make_unique<ClProgram>(context_.get(), device_.id, std::get<1>(key), *source,
                                               std::get<2>(key));
+  std::lock_guard<std::mutex> lock(*programs_mutex_);
+  if (const ClProgram* program = cached(given_hash)) return *program;
   return *programs_.emplace(std::move(key), std::move(entry)).first->second.program;
 }
 

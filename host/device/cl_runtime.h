@@ -429,13 +429,17 @@ class ClContext {
 
   // The program built from kernels/<kernel_file> (see KernelSource) with
   // `defines`; built on first use, then cached by (device, name, options).
+  // Thread-safe; several threads build different programs at once.
   const ClProgram& Program(std::string_view kernel_file, const BuildOptions& defines = {});
   // Same, from a source string (tests, generated code). `name` must identify
   // the source: reusing it with different source for the same options throws
   // std::logic_error rather than returning a stale program.
   const ClProgram& ProgramFromSource(std::string_view name, std::string_view source,
                                      const BuildOptions& defines = {});
-  size_t NumCachedPrograms() const { return programs_.size(); }
+  size_t NumCachedPrograms() const {
+    std::lock_guard<std::mutex> lock(*programs_mutex_);
+    return programs_.size();
+  }
 
   // The one launch path. Checks `local` against the device and the kernel
   // (work-group size, work-item sizes, reqd_work_group_size, local memory) and
@@ -476,6 +480,8 @@ class ClContext {
   std::array<bool, 1 + kLanes> leased_{};
   // Guards leased_ and Launch; a pointer so that the context stays movable.
   std::unique_ptr<std::mutex> mutex_ = std::make_unique<std::mutex>();
+  // Guards programs_ (not held while a program builds); a pointer likewise.
+  std::unique_ptr<std::mutex> programs_mutex_ = std::make_unique<std::mutex>();
   std::map<CacheKey, CacheEntry> programs_;
 };
 
