@@ -364,6 +364,31 @@ float ncc_of(float* a, const float* b, const float* w) {
   return ncc_against(a, sum_w, saa, b, w);
 }
 
+// The scale s of the sample weights: NCC_SIGMA_COLOR standard deviations of
+// the 3 x 3 samples `nine` around a window's centre, row by row. Their spread
+// is the texture of the centre's surface, not inflated by another surface
+// further out.
+float ncc_weight_scale(const float* nine) {
+  float mean = 0.0f;
+  for (int k = 0; k < 9; ++k) {
+    mean += nine[k];
+  }
+  mean /= 9.0f;
+  float var = 0.0f;
+  for (int k = 0; k < 9; ++k) {
+    const float d = nine[k] - mean;
+    var += d * d;
+  }
+  return NCC_SIGMA_COLOR * sqrt(var / 9.0f);
+}
+
+// The weight of reference sample `a` of a window whose centre sample is
+// `centre`, for the scale s of ncc_weight_scale.
+float ncc_weight(float a, float centre, float s) {
+  const float d = a - centre;
+  return s > 0.0f ? native_exp(-0.5f * (d * d) / (s * s)) : 1.0f;
+}
+
 // The weights of the reference samples `a`: 1 each when NCC_SIGMA_COLOR is
 // 0, else exp(-d^2 / 2 s^2) for d the sample's difference from the centre
 // sample and s = NCC_SIGMA_COLOR standard deviations of the 3 x 3 samples
@@ -381,28 +406,16 @@ void ncc_weights(const float* a, float* w) {
     }
     return;
   }
-  // The spread of the 3 x 3 samples around the centre: the texture of the
-  // centre's surface, not inflated by another surface further out.
   const int c = NCC_NUM_SAMPLES / 2;
-  float mean = 0.0f;
+  float nine[9];
   for (int r = -1; r <= 1; ++r) {
     for (int q = -1; q <= 1; ++q) {
-      mean += a[c + r * PATCH_SIZE + q];
+      nine[(r + 1) * 3 + q + 1] = a[c + r * PATCH_SIZE + q];
     }
   }
-  mean /= 9.0f;
-  float var = 0.0f;
-  for (int r = -1; r <= 1; ++r) {
-    for (int q = -1; q <= 1; ++q) {
-      const float d = a[c + r * PATCH_SIZE + q] - mean;
-      var += d * d;
-    }
-  }
-  const float s = NCC_SIGMA_COLOR * sqrt(var / 9.0f);
-  const float centre = a[c];
+  const float s = ncc_weight_scale(nine);
   for (int k = 0; k < NCC_NUM_SAMPLES; ++k) {
-    const float d = a[k] - centre;
-    w[k] = s > 0.0f ? native_exp(-0.5f * (d * d) / (s * s)) : 1.0f;
+    w[k] = ncc_weight(a[k], a[c], s);
   }
 }
 

@@ -27,23 +27,7 @@
 #endif
 
 #include "ncc.cl"
-
-// One refined patch (host: RefinedPatchOut, 48 bytes).
-typedef struct {
-  float4 center;  // xyz: refined centre; w: mean NCC over the views (NaN: none valid).
-  float4 normal;  // xyz: refined unit normal; w: candidates scored, the start included.
-  float4 params;  // x: depth offset along the ray from the start, in footprints;
-                  // y: yaw, z: pitch (radians); w: accepted moves.
-} RefinedPatchOut;
-
-// The patch frame: e_z points from the initial centre towards the reference
-// camera, e_x is the reference x axis made orthogonal to e_z, e_y = e_z x e_x.
-// The normal of (yaw, pitch) is
-//   cos(pitch) sin(yaw) e_x + sin(pitch) e_y + cos(pitch) cos(yaw) e_z.
-float3 normal_of(float3 e_x, float3 e_y, float3 e_z, float yaw, float pitch) {
-  const float cp = cos(pitch);
-  return (cp * sin(yaw)) * e_x + sin(pitch) * e_y + (cp * cos(yaw)) * e_z;
-}
+#include "patch_search.cl"
 
 // Mean NCC of the plane (c, n) seen through the reference window `win`, whose
 // samples `da` are centred by ncc_centre (sum_w, saa) and weighted by w,
@@ -77,9 +61,6 @@ float patch_views_ncc(__global const float* images, __global const int4* table,
   }
   return all_valid ? sum / (float)num_views : NAN;
 }
-
-// True when `score` beats `best`: valid, and best is NaN or strictly lower.
-bool improves(float score, float best) { return !isnan(score) && (isnan(best) || score > best); }
 
 // Refines patches[i] for i < num_patches against its views
 // view_indices[view_offsets[i] .. view_offsets[i + 1]) (CSR; the host checks
@@ -116,39 +97,19 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   }
   const NccPatch patch = patches[i];
   const int first = view_offsets[i];
-  const int num_views = view_offsets[i + 1] - first;
-  RefinedPatchOut out;
-  out.center = (float4)(patch.center.xyz, NAN);
-  out.normal = (float4)(patch.normal.xyz, 0.0f);
-  out.params = (float4)(0.0f, 0.0f, 0.0f, 0.0f);
-  // Guards only: the host rejects all of these before enqueueing.
-  if (patch.reference < 0 || patch.reference >= num_images || num_views < 1 ||
-      num_views > MAX_VIEWS) {
-    results[i] = out;
+  int num_views = 0;
+  int views[MAX_VIEWS];
+  if (!load_views(patches, i, view_offsets, view_indices, num_images, views, &num_views)) {
+    results[i] = unrefined(patch);
     return;
   }
-  int views[MAX_VIEWS];
-  for (int v = 0; v < num_views; ++v) {
-    views[v] = view_indices[first + v];
-    if (views[v] < 0 || views[v] >= num_images) {
-      results[i] = out;
-      return;
-    }
-  }
-
   const NccCamera ref = cameras[patch.reference];
-  const float3 origin = ref.center.xyz;
   const float3 c0 = patch.center.xyz;
-  const float t0 = length(c0 - origin);
-  const float3 ray = (c0 - origin) / t0;
-  const float3 e_z = -ray;
-  const float3 e_x = normalize(ref.x_axis.xyz - dot(ref.x_axis.xyz, e_z) * e_z);
-  const float3 e_y = cross(e_z, e_x);
-  const float3 n0 = patch.normal.xyz;
-  const float footprint = dot(ref.p2, (float4)(c0, 1.0f)) / ref.center.w;
+  const PatchFrame f = patch_frame(ref, c0);
 
-  float p[3] = {t0, atan2(dot(n0, e_x), dot(n0, e_z)), asin(clamp(dot(n0, e_y), -1.0f, 1.0f))};
-  float step[3] = {depth_step * footprint, angle_step, angle_step};
+  float p[3];
+  float step[3];
+  search_start(f, patch.normal.xyz, depth_step, angle_step, p, step);
   float nccs[MAX_VIEWS];
   float trial[MAX_VIEWS];
   for (int v = 0; v < num_views; ++v) {
@@ -184,8 +145,8 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   float score = NAN;
   if (window_valid && cos(p[1]) * cos(p[2]) >= cos_max) {
     score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views, win,
-                            da, w, sum_w, saa, origin + p[0] * ray,
-                            normal_of(e_x, e_y, e_z, p[1], p[2]), true, nccs);
+                            da, w, sum_w, saa, f.origin + p[0] * f.ray,
+                            normal_of(f.e_x, f.e_y, f.e_z, p[1], p[2]), true, nccs);
   }
   int moves = 0;
   int halvings = 0;
@@ -195,16 +156,16 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
     int moved = -1;
     for (int j = 0; j < 6 && moved < 0; ++j) {
       const int k = (lead + j) % 6;
-      float q[3] = {p[0], p[1], p[2]};
-      q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
-      if (!(cos(q[1]) * cos(q[2]) >= cos_max)) {
+      float q[3];
+      if (!poll_candidate(p, step, k, cos_max, q)) {
         continue;
       }
-      const float s = !window_valid
-                          ? NAN
-                          : patch_views_ncc(images, image_table, cameras, patch.reference, views,
-                                            num_views, win, da, w, sum_w, saa, origin + q[0] * ray,
-                                            normal_of(e_x, e_y, e_z, q[1], q[2]), false, trial);
+      const float s =
+          !window_valid
+              ? NAN
+              : patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views,
+                                win, da, w, sum_w, saa, f.origin + q[0] * f.ray,
+                                normal_of(f.e_x, f.e_y, f.e_z, q[1], q[2]), false, trial);
       ++evaluations;
       if (improves(s, score)) {
         moved = k;
@@ -225,10 +186,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
       ++halvings;
     }
   }
-  out.center = (float4)(origin + p[0] * ray, score);
-  out.normal = (float4)(normal_of(e_x, e_y, e_z, p[1], p[2]), (float)evaluations);
-  out.params = (float4)((p[0] - t0) / footprint, p[1], p[2], (float)moves);
-  results[i] = out;
+  results[i] = refined(f, p, score, evaluations, moves);
   for (int v = 0; v < num_views; ++v) {
     view_scores[first + v] = nccs[v];
   }

@@ -5,6 +5,8 @@
 // start. "patches/s" counts refined patches; "ncc_evals/s" the (1 + 6 x
 // iterations) x views NCC evaluations each patch's search scores at most
 // (an early stop after max_halvings scores fewer).
+// The fourth argument picks the layout (RefineLayout: 1 a work-item per
+// patch, 2 a work-group).
 //   SAPMVS_DEVICE=pocl ./build/profiling/bench_patch_refiner --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
@@ -58,6 +60,7 @@ void BM_RefineKernelDeviceTime(benchmark::State& state) {
   PatchRefinerOptions o;
   o.patch_size = static_cast<int>(state.range(1));
   o.max_halvings = static_cast<int>(state.range(2));
+  o.layout = state.range(3) == 1 ? RefineLayout::kPatchPerItem : RefineLayout::kPatchPerGroup;
   const RefineBatch r = MakeRefineBatch(static_cast<int>(state.range(0)));
   PatchRefiner refiner(*shared.context, o);
   refiner.SetGroup(r.batch.group);
@@ -85,8 +88,11 @@ void BM_RefineReference(benchmark::State& state) {
 
 // Third argument: max_halvings, the default against never stopping early
 // (kMaxRefineIterations), to show what the early stop saves on a device.
+// Fourth: the layout, 1 a work-item per patch, 2 a work-group (RefineLayout);
+// 64 patches is a launch of the polish sizes (about 60 on Herz-Jesu-P8).
 BENCHMARK(BM_RefineKernelDeviceTime)
-    ->ArgsProduct({{2000}, {7, 21}, {kDefaultRefineHalvings, kMaxRefineIterations}})
+    ->ArgsProduct({{2000, 64}, {7, 21}, {kDefaultRefineHalvings}, {1, 2}})
+    ->ArgsProduct({{2000}, {7, 21}, {kMaxRefineIterations}, {1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RefineReference)

@@ -127,8 +127,16 @@ double DepthErrorFootprints(const Camera& ref, const Eigen::Vector3d& c) {
   return std::abs(c.z() / ray.z()) / Footprint(ref, c);
 }
 
-class PatchRefinerTest : public ClTest {
+// Every test runs with both layouts of the device's search
+// (patch_refine.cl, patch_refine_group.cl) against the one reference.
+class PatchRefinerTest : public ClTest, public ::testing::WithParamInterface<RefineLayout> {
  protected:
+  static PatchRefinerOptions Options() {
+    PatchRefinerOptions o;
+    o.layout = GetParam();
+    return o;
+  }
+
   // Refines on the device with `options` and compares with the reference;
   // `refined`, if given, receives the device's patches.
   RefComparison RefineAndCompare(const PlaneScene& scene, const std::vector<NccPatch>& patches,
@@ -145,7 +153,7 @@ class PatchRefinerTest : public ClTest {
   }
 };
 
-TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
+TEST_P(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
   const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
   std::vector<NccPatch> patches;
   std::vector<std::vector<int>> views;
@@ -154,7 +162,7 @@ TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
   // NCC is nearly flat in the normal; the search then ends above the true
   // plane's own score (0.996 to 0.999, limited by bilinear interpolation) but
   // up to 5.2 degrees off its normal. 11x11 pins the normal to 2.4 degrees.
-  PatchRefinerOptions options;
+  PatchRefinerOptions options = Options();
   options.patch_size = 11;
   std::vector<RefinedPatch> refined;
   const RefComparison vs = RefineAndCompare(scene, patches, views, options, &refined);
@@ -190,12 +198,12 @@ TEST_F(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
       vs.worst_depth_error, vs.worst_angle_error);
 }
 
-TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
+TEST_P(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
   const PlaneScene scene = MakePlaneScene(4, 161, 123, 61);
   std::vector<NccPatch> patches;
   std::vector<std::vector<int>> views;
   PerturbedPatches(scene, 16, 4.0, 25.0, 62, &patches, &views);
-  PatchRefinerOptions options;
+  PatchRefinerOptions options = Options();
   options.patch_size = 5;
   options.iterations = 12;
   const RefComparison c = RefineAndCompare(scene, patches, views, options);
@@ -228,13 +236,13 @@ TEST_F(PatchRefinerTest, MatchesReferenceOnHarderStarts) {
 // halving allowed a search ends at its first failed round, so it takes at
 // most as many moves as with the default, and kernel and reference stop at
 // the same round. With the default, the patches still reach the plane.
-TEST_F(PatchRefinerTest, StopsAfterMaxHalvings) {
+TEST_P(PatchRefinerTest, StopsAfterMaxHalvings) {
   // The scene of ConvergesToThePlaneAndMatchesReference.
   const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
   std::vector<NccPatch> patches;
   std::vector<std::vector<int>> views;
   PerturbedPatches(scene, 12, 2.5, 15.0, 52, &patches, &views);
-  PatchRefinerOptions options;
+  PatchRefinerOptions options = Options();
   options.patch_size = 11;
   options.iterations = 200;
   options.max_halvings = 1;
@@ -263,12 +271,12 @@ TEST_F(PatchRefinerTest, StopsAfterMaxHalvings) {
 // Sample weights (sigma_color 3, the matcher's default): the weighted search
 // takes the reference's path where its decisions are clear, and converges to
 // the plane as the plain one does (ConvergesToThePlaneAndMatchesReference).
-TEST_F(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
+TEST_P(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
   const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
   std::vector<NccPatch> patches;
   std::vector<std::vector<int>> views;
   PerturbedPatches(scene, 12, 2.5, 15.0, 52, &patches, &views);
-  PatchRefinerOptions options;
+  PatchRefinerOptions options = Options();
   options.patch_size = 11;
   options.sigma_color = 3.0;
   options.iterations = 4;
@@ -301,7 +309,7 @@ TEST_F(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
 // ends on the cone's rim (within a step of it), never past it. A search that
 // could leave the cone, or one that bounded yaw and pitch each, ended outside
 // it on Herz-Jesu-P8's forecourt and the matcher rejected the patch.
-TEST_F(PatchRefinerTest, StaysWithinMaxAngleOfTheReferenceRay) {
+TEST_P(PatchRefinerTest, StaysWithinMaxAngleOfTheReferenceRay) {
   const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
   const Camera& ref = scene.cameras[0];
   std::vector<NccPatch> patches;
@@ -313,7 +321,7 @@ TEST_F(PatchRefinerTest, StaysWithinMaxAngleOfTheReferenceRay) {
     patches.push_back(MakeNccPatch(s.center, to_ref, 0));
     views.push_back({1, 2, 3});
   }
-  PatchRefinerOptions options;
+  PatchRefinerOptions options = Options();
   options.patch_size = 11;
   options.angle_step_deg = 2.0;
   options.max_angle_deg = 0.5 * least_true_angle;
@@ -343,9 +351,9 @@ TEST_F(PatchRefinerTest, StaysWithinMaxAngleOfTheReferenceRay) {
   EXPECT_GE(on_rim, scored / 2);
 }
 
-TEST_F(PatchRefinerTest, RejectsInvalidInputsBeforeEnqueue) {
+TEST_P(PatchRefinerTest, RejectsInvalidInputsBeforeEnqueue) {
   const PlaneScene scene = MakePlaneScene(4, 97, 81, 71);
-  PatchRefiner refiner(context());
+  PatchRefiner refiner(context(), Options());
   std::vector<NccPatch> patches;
   std::vector<std::vector<int>> views;
   PerturbedPatches(scene, 2, 1.0, 5.0, 72, &patches, &views);
@@ -384,6 +392,44 @@ TEST_F(PatchRefinerTest, RejectsInvalidInputsBeforeEnqueue) {
                             }()),
                Error);
 }
+
+// Every window size the matcher refines at (7 x 7 to 21 x 21, and 3 and 9):
+// the work-group layout holds 1 to 7 samples a work-item, with idle ones at
+// 3 x 3 and 7 x 7, and both layouts must agree with the reference.
+TEST_P(PatchRefinerTest, MatchesReferenceAtEveryWindowSize) {
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 81);
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 9, 1.5, 10.0, 82, &patches, &views);
+  for (const int size : {3, 7, 9, 15, 21}) {
+    PatchRefinerOptions options = Options();
+    options.patch_size = size;
+    options.iterations = 4;
+    const RefComparison c = RefineAndCompare(scene, patches, views, options);
+    std::printf("[ REFINE   ] %d x %d: worst score error %.3g, %d/%zu same-path\n", size, size,
+                c.worst_score_error, c.same_path, patches.size());
+    // Some searches had clear decisions all the way: their paths were compared.
+    EXPECT_GE(c.same_path, 1) << size << " x " << size;
+  }
+}
+
+// kAuto: a work-item per patch on a CPU device, a work-group elsewhere.
+TEST_P(PatchRefinerTest, AutoLayoutIsAWorkItemOnCpusAndAWorkGroupElsewhere) {
+  const PatchRefiner given(context(), Options());
+  EXPECT_EQ(given.layout(), GetParam());
+  const PatchRefiner automatic(context(), PatchRefinerOptions());
+  EXPECT_EQ(automatic.layout(), context().device().type == DeviceType::kCpu
+                                    ? RefineLayout::kPatchPerItem
+                                    : RefineLayout::kPatchPerGroup);
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, PatchRefinerTest,
+                         ::testing::Values(RefineLayout::kPatchPerItem,
+                                           RefineLayout::kPatchPerGroup),
+                         [](const ::testing::TestParamInfo<RefineLayout>& param_info) {
+                           return param_info.param == RefineLayout::kPatchPerItem ? "WorkItem"
+                                                                                  : "WorkGroup";
+                         });
 
 }  // namespace
 }  // namespace sapmvs

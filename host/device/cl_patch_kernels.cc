@@ -24,15 +24,16 @@ namespace {
 // One scorer per distinct NccScorerOptions, one refiner per distinct
 // PatchRefinerOptions (each is a program built with those -D options).
 using ScorerKey = std::tuple<int, int, double, double>;
-using RefinerKey = std::tuple<int, int, int, int, double, double, double, double, double>;
+using RefinerKey =
+    std::tuple<int, int, RefineLayout, int, int, double, double, double, double, double>;
 
 ScorerKey KeyOf(const NccScorerOptions& o) {
   return {o.patch_size, o.work_group_size, o.sigma_color, o.sample_step};
 }
 
 RefinerKey KeyOf(const PatchRefinerOptions& o) {
-  return {o.patch_size,     o.work_group_size, o.iterations,  o.max_halvings, o.depth_step,
-          o.angle_step_deg, o.max_angle_deg,   o.sigma_color, o.sample_step};
+  return {o.patch_size, o.work_group_size, o.layout,        o.iterations,  o.max_halvings,
+          o.depth_step, o.angle_step_deg,  o.max_angle_deg, o.sigma_color, o.sample_step};
 }
 
 double Seconds(const ClEvent& event) {

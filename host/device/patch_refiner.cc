@@ -14,8 +14,10 @@
 namespace sapmvs {
 namespace {
 
-constexpr char kKernelFile[] = "patch_refine.cl";
-constexpr char kKernel[] = "patch_refine";
+constexpr char kItemFile[] = "patch_refine.cl";
+constexpr char kItemKernel[] = "patch_refine";
+constexpr char kGroupFile[] = "patch_refine_group.cl";
+constexpr char kGroupKernel[] = "patch_refine_group";
 constexpr double kPi = 3.14159265358979323846;
 
 double Radians(double degrees) { return degrees * kPi / 180.0; }
@@ -26,10 +28,14 @@ PatchRefiner::PatchRefiner(ClContext& context, const PatchRefinerOptions& option
     : context_(context), options_(options) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("PatchRefinerOptions: expected " + problem);
-  BuildOptions defines = NccBuildOptions(options.patch_size, options.work_group_size,
-                                         options.sigma_color, options.sample_step);
+  per_group_ = options.layout == RefineLayout::kPatchPerGroup ||
+               (options.layout == RefineLayout::kAuto && context.device().type != DeviceType::kCpu);
+  local_size_ = per_group_ ? RefineGroupWorkItems(options.patch_size) : options.work_group_size;
+  BuildOptions defines =
+      NccBuildOptions(options.patch_size, local_size_, options.sigma_color, options.sample_step);
   defines.Define("MAX_VIEWS", kMaxViews);
-  kernel_ = context_.Program(kKernelFile, defines).Kernel(kKernel);
+  kernel_ = context_.Program(per_group_ ? kGroupFile : kItemFile, defines)
+                .Kernel(per_group_ ? kGroupKernel : kItemKernel);
 }
 
 void PatchRefiner::SetGroup(const NccGroup& group) {
@@ -68,8 +74,9 @@ std::vector<RefinedPatch> PatchRefiner::Refine(const std::vector<NccPatch>& patc
   ClBuffer result_buffer(context_, patches.size() * sizeof(RefinedPatchOut), CL_MEM_WRITE_ONLY);
   ClBuffer score_buffer(context_, indices.size() * sizeof(float), CL_MEM_WRITE_ONLY);
 
+  const size_t local = static_cast<size_t>(local_size_);
   ClEvent launched = context_.Launch(
-      kernel_, NDRange(patches.size()), NDRange(static_cast<size_t>(options_.work_group_size)),
+      kernel_, NDRange(per_group_ ? patches.size() * local : patches.size()), NDRange(local),
       group_->images, group_->image_table, group_->cameras, cl_int{group_->num_images},
       patch_buffer, static_cast<cl_int>(patches.size()), offset_buffer, index_buffer,
       cl_int{options_.iterations}, cl_int{options_.max_halvings},

@@ -57,10 +57,16 @@ class PatchRefiner {
                                    ClEvent* event = nullptr);
 
   const PatchRefinerOptions& options() const { return options_; }
+  // options().layout resolved for the device (never kAuto).
+  RefineLayout layout() const {
+    return per_group_ ? RefineLayout::kPatchPerGroup : RefineLayout::kPatchPerItem;
+  }
 
  private:
   ClContext& context_;
   PatchRefinerOptions options_;
+  bool per_group_ = false;  // options_.layout resolved for the device
+  int local_size_ = 0;      // work-items per work-group
   ClKernel kernel_;
   std::shared_ptr<const NccDeviceGroup> group_;
   std::vector<NccCamera> host_cameras_;

@@ -130,15 +130,25 @@ struct NccScorerOptions {
   std::string Problem() const;
 };
 
+// How an OpenCL device runs the refinement's search: each patch in one
+// work-item (kernels/patch_refine.cl), or in one work-group whose work-items
+// share its window's samples (patch_refine_group.cl). kAuto takes a work-group
+// on GPUs and other non-CPU devices, a work-item on CPUs. Both give the same
+// search; their scores differ in the last bits (the order of the sums).
+enum class RefineLayout { kAuto, kPatchPerItem, kPatchPerGroup };
+
 // The refinement's search (patch_refiner.h describes it).
 struct PatchRefinerOptions {
   // μ: samples per side of the patch grid (-D PATCH_SIZE). Odd, 3 to kMaxPatchSize.
   int patch_size = kDefaultPatchSize;
   // Spacing of the samples in reference pixels (NccScorerOptions::sample_step).
   double sample_step = 1.0;
-  // Work-items per work-group (-D WORK_GROUP_SIZE), >= 1 (the CPU reference
-  // ignores it).
+  // Work-items per work-group (-D WORK_GROUP_SIZE) where a work-item
+  // searches a patch, >= 1 (a work-group per patch has RefineGroupWorkItems;
+  // the CPU reference ignores both).
   int work_group_size = kDefaultWorkGroupSize;
+  // Work-item or work-group per patch (the CPU reference ignores it).
+  RefineLayout layout = RefineLayout::kAuto;
   // Search rounds, each scoring 6 candidates; 0 to kMaxRefineIterations.
   int iterations = kDefaultRefineIterations;
   // Stop after the steps were halved this many times (converged); >= 1.

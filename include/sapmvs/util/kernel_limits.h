@@ -19,6 +19,13 @@ inline constexpr int kDefaultWorkGroupSize = 64;
 // smaller groups only spread so few patches over more compute units.
 inline constexpr int kPolishWorkGroupSize = 8;
 
+// Work-items of one patch in patch_refine_group.cl, the refinement GPUs run
+// (RefineLayout): a power of two, so that each NCC's sums reduce in a tree;
+// about two to seven samples each (7 x 7 has 49, 21 x 21 441).
+inline constexpr int RefineGroupWorkItems(int patch_size) {
+  return patch_size * patch_size <= 64 ? 32 : 64;
+}
+
 // Largest side of a square matching window, in pixels (odd). Bounds the
 // per-work-item private arrays of the NCC kernels.
 inline constexpr int kMaxPatchSize = 21;
