@@ -1,9 +1,11 @@
 #pragma once
-// Batched patch refinement on an OpenCL device (kernels/patch_refine.cl); its
-// double-precision twin is PatchRefineReference (patch_refine_reference.h),
-// its options and results are in patch_kernel_types.h. For each patch (NccPatch: centre, unit
-// normal, reference image) and its list of views, a fixed-iteration pattern search in-kernel
-// optimises three parameters to maximise the mean NCC (ncc_scorer.h's score) over the views:
+// Batched patch refinement on an OpenCL device (kernels/patch_refine.cl, a
+// work-item per patch, on CPUs; patch_refine_group.cl, a work-group per patch,
+// elsewhere: PatchRefinerOptions::layout); its double-precision twin is PatchRefineReference
+// (patch_refine_reference.h), its options and results are in patch_kernel_types.h. For each patch
+// (NccPatch: centre, unit normal, reference image) and its list of views, a fixed-iteration pattern
+// search in-kernel optimises three parameters to maximise the mean NCC (ncc_scorer.h's score) over
+// the views:
 //   t      distance from the reference camera centre along the ray through the
 //          initial centre (the centre stays on that ray: c = C + t r);
 //   yaw    rotation of the normal about e_y, and

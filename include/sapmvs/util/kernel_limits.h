@@ -13,10 +13,10 @@ namespace sapmvs {
 inline constexpr int kDefaultWorkGroupSize = 64;
 
 // Work-items per work-group of the polish refinements (the larger adaptive
-// sizes, patch_engine.cc). Their launches hold tens to hundreds of patches:
-// in groups of 64 that was one to three work-groups, so one of PoCL's
-// threads often refined them all while the other waited. On a GPU the
-// smaller groups only spread so few patches over more compute units.
+// sizes, patch_engine.cc) where a work-item refines a patch (CPUs;
+// RefineLayout). Their launches hold tens to hundreds of patches: in groups
+// of 64 that was one to three work-groups, so one of PoCL's threads often
+// refined them all while the other waited.
 inline constexpr int kPolishWorkGroupSize = 8;
 
 // Work-items of one patch in patch_refine_group.cl, the refinement GPUs run
