@@ -270,12 +270,19 @@ TEST_F(ClRuntimeTest, ProgramCacheKeyedByOptions) {
 }
 
 TEST_F(ClRuntimeTest, ProgramsBuiltOnSeveralThreadsAreCachedOncePerKey) {
-  // Each thread asks for the same three keys in its own order, so threads
-  // miss the same key at once and build it twice; one program per key stays,
-  // and every thread gets that one.
+  // Each thread asks for the same keys in its own order, so threads miss the
+  // same key at once and build it twice; one program per key stays, and every
+  // thread gets that one. Half the keys are source programs, half kernel
+  // files (whose source the cache loads itself).
   ClContext fresh(context().device(), /*profile=*/false);
   constexpr int kThreads = 6;
-  constexpr int kKeys = 3;
+  constexpr int kKeys = 6;
+  const auto program = [&fresh](int k) -> const ClProgram& {
+    if (k % 2 == 0) {
+      return fresh.ProgramFromSource("iota_test", kIotaSource, {{"SCALE", std::to_string(k + 1)}});
+    }
+    return fresh.Program("bilinear_sample.cl", {{"WORK_GROUP_SIZE", std::to_string(8 << k)}});
+  };
   std::vector<std::vector<const ClProgram*>> got(kThreads, std::vector<const ClProgram*>(kKeys));
   std::vector<std::string> errors(kThreads);
   std::vector<std::thread> threads;
@@ -284,8 +291,7 @@ TEST_F(ClRuntimeTest, ProgramsBuiltOnSeveralThreadsAreCachedOncePerKey) {
       try {
         for (int j = 0; j < kKeys; ++j) {
           const int k = (t + j) % kKeys;
-          got[t][k] = &fresh.ProgramFromSource("iota_test", kIotaSource,
-                                               {{"SCALE", std::to_string(k + 1)}});
+          got[t][k] = &program(k);
         }
       } catch (const std::exception& e) {
         errors[t] = e.what();
@@ -296,9 +302,10 @@ TEST_F(ClRuntimeTest, ProgramsBuiltOnSeveralThreadsAreCachedOncePerKey) {
   for (int t = 0; t < kThreads; ++t) ASSERT_EQ(errors[t], "") << "thread " << t;
   EXPECT_EQ(fresh.NumCachedPrograms(), static_cast<size_t>(kKeys));
   for (int k = 0; k < kKeys; ++k) {
-    const ClProgram* kept =
-        &fresh.ProgramFromSource("iota_test", kIotaSource, {{"SCALE", std::to_string(k + 1)}});
-    EXPECT_EQ(kept->options(), "-cl-std=CL1.2 -D SCALE=" + std::to_string(k + 1));
+    const ClProgram* kept = &program(k);
+    EXPECT_EQ(kept->options(), k % 2 == 0
+                                   ? "-cl-std=CL1.2 -D SCALE=" + std::to_string(k + 1)
+                                   : "-cl-std=CL1.2 -D WORK_GROUP_SIZE=" + std::to_string(8 << k));
     for (int t = 0; t < kThreads; ++t) EXPECT_EQ(got[t][k], kept) << "thread " << t << " key " << k;
   }
 }

@@ -579,35 +579,38 @@ const ClProgram& ClContext::ProgramFromSource(std::string_view name, std::string
 const ClProgram& ClContext::CachedProgram(std::string_view name, const BuildOptions& defines,
                                           std::optional<std::string_view> source) {
   CacheKey key{device_.id, std::string(name), defines.Render()};
-  const auto cached = [&](size_t source_hash) -> const ClProgram* {
+  // A caller's source must match the cached program's; a kernel file's is
+  // the file's, loaded below on a miss.
+  const bool given = source.has_value();
+  const size_t source_hash = given ? std::hash<std::string_view>{}(*source) : 0;
+  const auto cached = [&]() -> const ClProgram* {
     const auto it = programs_.find(key);
     if (it == programs_.end()) return nullptr;
-    if (source && source_hash != it->second.source_hash) {
+    if (given && source_hash != it->second.source_hash) {
       throw std::logic_error("OpenCL program name \"" + std::string(name) +
                              "\" reused for a different source");
     }
     return it->second.program.get();
   };
-  const size_t given_hash = source ? std::hash<std::string_view>{}(*source) : 0;
   {
     std::lock_guard<std::mutex> lock(*programs_mutex_);
-    if (const ClProgram* program = cached(given_hash)) return *program;
+    if (const ClProgram* program = cached()) return *program;
   }
   // Built outside the lock: a GPU driver's compiler takes a second or more
   // per program on a cold cache, and the variants build on several threads
   // (PatchKernels::Prepare). Two threads missing the same key both build;
   // the first to finish is kept.
   std::string loaded;
-  if (!source) {
+  if (!given) {
     loaded = ProgramSource(name);
     source = loaded;
   }
   CacheEntry entry;
-  entry.source_hash = std::hash<std::string_view>{}(*source);
+  entry.source_hash = given ? source_hash : std::hash<std::string_view>{}(*source);
   entry.program = std::make_unique<ClProgram>(context_.get(), device_.id, std::get<1>(key), *source,
                                               std::get<2>(key));
   std::lock_guard<std::mutex> lock(*programs_mutex_);
-  if (const ClProgram* program = cached(given_hash)) return *program;
+  if (const ClProgram* program = cached()) return *program;
   return *programs_.emplace(std::move(key), std::move(entry)).first->second.program;
 }
 
