@@ -307,6 +307,16 @@ bool ncc_centre(float* a, const float* w, float* sum_w, float* saa) {
   return ss >= NCC_MIN_VARIANCE * sw;
 }
 
+// The NCC from a window's weighted sums (saa and sbb, the squared deviations
+// of the reference and the view; sab, their products; sum_w, the weights);
+// NaN when the view's variance is below NCC_MIN_VARIANCE.
+float ncc_of_sums(float saa, float sbb, float sab, float sum_w) {
+  if (!(sbb >= NCC_MIN_VARIANCE * sum_w)) {
+    return NAN;
+  }
+  return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+}
+
 // The NCC of a window centred by ncc_centre (`da`, sum_w, saa) and `b`,
 // two-pass so that bright images do not lose the variance to cancellation;
 // NaN when b's weighted variance is below NCC_MIN_VARIANCE. The sums run in
@@ -346,10 +356,7 @@ float ncc_against(const float* da, float sum_w, float saa, const float* b, const
   sbb += (a4.x + a4.y) + (a4.z + a4.w);
   a4 = ab.lo + ab.hi;
   sab += (a4.x + a4.y) + (a4.z + a4.w);
-  if (!(sbb >= NCC_MIN_VARIANCE * sum_w)) {
-    return NAN;
-  }
-  return clamp(sab / sqrt(saa * sbb), -1.0f, 1.0f);
+  return ncc_of_sums(saa, sbb, sab, sum_w);
 }
 
 // The NCC of `a` and `b`, each sample k weighted by w[k]; NaN when either

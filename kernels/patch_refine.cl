@@ -143,7 +143,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   // halves its steps to the end as the reference's does.
   const float cos_max = cos(max_angle);
   float score = NAN;
-  if (window_valid && cos(p[1]) * cos(p[2]) >= cos_max) {
+  if (window_valid && in_cone(p, cos_max)) {
     score = patch_views_ncc(images, image_table, cameras, patch.reference, views, num_views, win,
                             da, w, sum_w, saa, f.origin + p[0] * f.ray,
                             normal_of(f.e_x, f.e_y, f.e_z, p[1], p[2]), true, nccs);

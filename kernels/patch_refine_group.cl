@@ -181,7 +181,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
     while (!scoring && !done) {
       if (!started) {
         started = true;
-        if (!(window_valid && cos(p[1]) * cos(p[2]) >= cos_max)) {
+        if (!(window_valid && in_cone(p, cos_max))) {
           continue;
         }
         k = -1;
@@ -264,10 +264,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
     }
     const float2 sd = group_sum2(dev, scratch);
     if (!done) {
-      float ncc = NAN;
-      if (sb.y == 0.0f && sd.x >= NCC_MIN_VARIANCE * sum_w) {
-        ncc = clamp(sd.y / sqrt(saa * sd.x), -1.0f, 1.0f);
-      }
+      const float ncc = sb.y == 0.0f ? ncc_of_sums(saa, sd.x, sd.y, sum_w) : NAN;
       trial[v] = ncc;
       if (isnan(ncc)) {
         all_valid = false;

@@ -100,14 +100,18 @@ void search_start(const PatchFrame f, float3 n0, float depth_step, float angle_s
   step[2] = angle_step;
 }
 
+// Whether the normal of search point p lies inside the cone of the reference
+// ray whose half-angle has the cosine cos_max.
+bool in_cone(const float* p, float cos_max) { return cos(p[1]) * cos(p[2]) >= cos_max; }
+
 // Candidate k (+t, -t, +yaw, -yaw, +pitch, -pitch) around p into q; false when
-// its normal lies outside the cone of the reference ray (cos_max).
+// its normal lies outside the cone (in_cone).
 bool poll_candidate(const float* p, const float* step, int k, float cos_max, float* q) {
   q[0] = p[0];
   q[1] = p[1];
   q[2] = p[2];
   q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
-  return cos(q[1]) * cos(q[2]) >= cos_max;
+  return in_cone(q, cos_max);
 }
 
 #endif  // SAPMVS_PATCH_SEARCH_CL
