@@ -1,14 +1,11 @@
 #include "device/cl_patch_kernels.h"
 
 #include <algorithm>
-#include <atomic>
 #include <exception>
 #include <functional>
 #include <map>
 #include <mutex>
 #include <string>
-#include <system_error>
-#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -16,6 +13,7 @@
 #include "device/ncc_scorer.h"
 #include "device/patch_refiner.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/parallel_for.h"
 #include "sapmvs/util/thread_count.h"
 
 namespace sapmvs {
@@ -85,28 +83,17 @@ class ClPatchKernels : public PatchKernels {
     for (const PatchRefinerOptions& o : refiners) {
       builds.emplace_back([this, o] { PatchRefiner refiner(context_, o); });
     }
-    std::atomic<size_t> next{0};
-    const auto work = [&] {
-      for (size_t i; (i = next.fetch_add(1)) < builds.size();) {
-        try {
-          builds[i]();
-        } catch (const std::exception&) {  // the launch reports it
-        }
-      }
-    };
     // MatchGroup's thread loads the images meanwhile: one of the host's
     // threads fewer (so none more on two cores).
-    const size_t cores = static_cast<size_t>(std::max(2, HostThreadCount()));
-    std::vector<std::thread> threads;
-    for (size_t t = 1; t < std::min(builds.size(), cores - 1); ++t) {
-      try {
-        threads.emplace_back(work);
-      } catch (const std::system_error&) {  // fewer threads, same builds
-        break;
-      }
-    }
-    work();
-    for (std::thread& t : threads) t.join();
+    ParallelFor(
+        static_cast<long>(builds.size()),
+        [&builds](long i) {
+          try {
+            builds[static_cast<size_t>(i)]();
+          } catch (const std::exception&) {  // the launch reports it
+          }
+        },
+        /*block=*/1, std::max(1, HostThreadCount() - 1));
   }
 
   bool ConcurrentLaunches() const override { return true; }
