@@ -83,6 +83,31 @@ TEST(ParallelFor, SharesTheWorkAndLeavesNoThreadBehind) {
   EXPECT_TRUE(ids.count(std::this_thread::get_id())) << "the caller takes part";
 }
 
+// --threads holds on threads the program starts itself, where OpenMP's own
+// count (omp_set_num_threads, per thread) does not reach.
+TEST(ParallelFor, KeepsToTheThreadCountOnOtherThreadsToo) {
+  const int all = HostThreadCount();
+  if (all < 2) GTEST_SKIP() << "one host thread: no count below it to set";
+  SetThreadCount(1);
+  int seen = 0;
+  std::set<std::thread::id> ids;
+  std::thread side([&] {
+    seen = HostThreadCount();
+    std::mutex m;
+    ParallelFor(
+        64,
+        [&](long) {
+          std::lock_guard<std::mutex> lock(m);
+          ids.insert(std::this_thread::get_id());
+        },
+        1);
+  });
+  side.join();
+  SetThreadCount(all);  // what the other tests of this process expect
+  EXPECT_EQ(seen, 1);
+  EXPECT_EQ(ids.size(), 1u);
+}
+
 TEST(ParallelFor, RethrowsTheFirstFailureAfterEveryThreadStopped) {
   std::atomic<long> calls{0};
   auto run = [&] {

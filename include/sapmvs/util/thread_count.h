@@ -12,7 +12,8 @@ namespace sapmvs {
 // count.
 void SetThreadCount(int threads);
 
-// The threads the host's parallel loops use now (OpenMP's maximum).
+// The threads the host's parallel loops use: SetThreadCount's count on every
+// thread once it was given one, else OpenMP's maximum.
 int HostThreadCount();
 
 }  // namespace sapmvs
