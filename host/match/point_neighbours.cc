@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <string>
@@ -34,6 +35,22 @@ inline float SquaredDistance(const float* q, const Entry& e) {
   d2 += dx * dx;
   d2 += dy * dy;
   d2 += dz * dz;
+  return d2;
+}
+
+// A neighbour as one key that orders as (squared distance, index): the
+// distance's bits above the index. A float >= 0 orders as its bits read as
+// an unsigned integer (the squared distance is a sum of squares, never -0).
+inline uint64_t Key(float d2, int32_t index) {
+  uint32_t bits;
+  std::memcpy(&bits, &d2, sizeof bits);
+  return static_cast<uint64_t>(bits) << 32 | static_cast<uint32_t>(index);
+}
+
+inline float KeyDistance(uint64_t key) {
+  const uint32_t bits = static_cast<uint32_t>(key >> 32);
+  float d2;
+  std::memcpy(&d2, &bits, sizeof d2);
   return d2;
 }
 
@@ -100,27 +117,30 @@ class ColumnGrid {
   // point `self`, whose squared distance is at most r2, nearest first (ties
   // by index); the rest -1. Columns are visited in rings around p's and
   // skipped once they lie farther than the k-th point found, so that a
-  // point among many others reads little more than its own ring.
+  // point among many others reads little more than its own ring. `best` is
+  // the caller's scratch (one per thread).
   void Nearest(const float* p, int32_t self, float r2, double reach, int k, int32_t* out,
-               std::vector<std::pair<float, int32_t>>* best) const {
-    best->clear();
+               std::vector<uint64_t>* best) const {
+    best->resize(k);
+    uint64_t* held = best->data();
+    int count = 0;
+    // The bar a point must pass: within the radius, and once k are held,
+    // no farther than the farthest of them (a tie then goes by index).
+    float bar = r2;
     const int u0 = Cell(p[u_] - reach, u_, nu_), u1 = Cell(p[u_] + reach, u_, nu_);
     const int v0 = Cell(p[v_] - reach, v_, nv_), v1 = Cell(p[v_] + reach, v_, nv_);
     const int w0 = Cell(p[w_] - reach, w_, nw_), w1 = Cell(p[w_] + reach, w_, nw_);
     const int cu = Cell(p[u_], u_, nu_), cv = Cell(p[v_], v_, nv_);
     const int rings = std::max({cu - u0, u1 - cu, cv - v0, v1 - cv});
-    // The bar a point must pass: within the radius, and once k are held,
-    // nearer than the farthest of them.
-    auto full = [&] { return static_cast<int>(best->size()) == k; };
     auto visit = [&](int iu, int iv) {
-      if (full()) {
+      if (count == k) {
         // The column's nearest possible point, a little nearer than exact,
         // so that rounding never skips a point that would have counted.
         const double du =
             std::max({0.0, lo_[u_] + iu * cell_ - p[u_], p[u_] - (lo_[u_] + (iu + 1) * cell_)});
         const double dv =
             std::max({0.0, lo_[v_] + iv * cell_ - p[v_], p[v_] - (lo_[v_] + (iv + 1) * cell_)});
-        if ((du * du + dv * dv) * (1 - 1e-5) > best->back().first) return;
+        if ((du * du + dv * dv) * (1 - 1e-5) > KeyDistance(held[k - 1])) return;
       }
       const size_t c = static_cast<size_t>(iu) * nv_ + iv;
       auto it = entries_.begin() + start_[c];
@@ -128,15 +148,21 @@ class ColumnGrid {
       if (it == end) return;
       it = std::lower_bound(it, end, w0, [](const Entry& e, int w) { return e.w < w; });
       for (; it != end && it->w <= w1; ++it) {
-        if (it->index == self) continue;
         const float d2 = SquaredDistance(p, *it);
-        if (!(d2 <= r2)) continue;
-        const std::pair<float, int32_t> x(d2, it->index);
-        if (full()) {
-          if (!(x < best->back())) continue;
-          best->pop_back();
+        if (!(d2 <= bar) || it->index == self) continue;
+        const uint64_t key = Key(d2, it->index);
+        int at = count;
+        if (count == k) {
+          if (key > held[k - 1]) continue;
+          at = k - 1;
+        } else {
+          ++count;
         }
-        best->insert(std::upper_bound(best->begin(), best->end(), x), x);
+        // Insertion from the back: most points that get in are among the
+        // farthest held.
+        for (; at > 0 && held[at - 1] > key; --at) held[at] = held[at - 1];
+        held[at] = key;
+        if (count == k) bar = std::min(r2, KeyDistance(held[k - 1]));
       }
     };
     for (int ring = 0; ring <= rings; ++ring) {
@@ -153,8 +179,8 @@ class ColumnGrid {
         }
       }
     }
-    for (size_t j = 0; j < best->size(); ++j) out[j] = (*best)[j].second;
-    std::fill(out + best->size(), out + k, -1);
+    for (int j = 0; j < count; ++j) out[j] = static_cast<int32_t>(held[j] & 0xffffffffu);
+    std::fill(out + count, out + k, -1);
   }
 
   // The e-th point in column order.
@@ -213,8 +239,7 @@ UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
 
 #pragma omp parallel
   {
-    std::vector<std::pair<float, int32_t>> best;
-    best.reserve(k);
+    std::vector<uint64_t> best;
     // In the grid's order, so that consecutive queries read the same columns.
 #pragma omp for schedule(dynamic, 512)
     for (size_t e = 0; e < n; ++e) {
