@@ -7,6 +7,8 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <stdexcept>
+#include <thread>
 
 namespace sapmvs {
 namespace {
@@ -97,6 +99,17 @@ TEST(MemoryUse, ScopedHeapReuseKeepsFreedBlocksUntilItEnds) {
   held = CurrentRssBytes();
   block.reset();
   EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
+}
+
+// The work runs on another thread (ScopedHeapReuseKeepsFreedBlocksUntilItEnds
+// covers the reuse), and what it throws arrives here.
+TEST(MemoryUse, RunWithHeapReuseRunsOnAnotherThreadAndRethrows) {
+  const std::thread::id caller = std::this_thread::get_id();
+  std::thread::id ran_on = caller;
+  RunWithHeapReuse([&] { ran_on = std::this_thread::get_id(); });
+  EXPECT_NE(ran_on, caller);
+  EXPECT_THROW(RunWithHeapReuse([] { throw std::runtime_error("from the work"); }),
+               std::runtime_error);
 }
 
 // An address-space limit (a batch system's h_vmem) or a data limit

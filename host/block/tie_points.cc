@@ -225,31 +225,15 @@ std::vector<TiePoint> TriangulateTiePoints(const Block& block, const TiePointOpt
   // and decodes the file on one: with one image at a time, 1.3 of 2 cores
   // were busy (`small`'s planning, 1.6 s of its 7).
   try {
-    // SIFT's buffers are reused from the heap (ScopedHeapReuse), and on
-    // threads other than this one, so that they come from those threads'
-    // arenas: from this thread's, the main heap, the holes they left under
-    // a later allocation stayed resident through the matching (`small` in
-    // pmvs mode: 193-196 MiB at its peak against 190).
-    const ScopedHeapReuse reuse;
-    std::exception_ptr failed;
-    auto detect = [&] {
-      try {
-        ParallelFor(
-            static_cast<long>(with_files.size()),
-            [&](long w) {
-              images[with_files[w]] = Detect(block.images[with_files[w]], block.origin, o);
-            },
-            1, o.concurrent_images);
-      } catch (...) {
-        failed = std::current_exception();
-      }
-    };
-    try {
-      std::thread(detect).join();
-    } catch (const std::system_error&) {  // no thread to be had: on this one
-      detect();
-    }
-    if (failed) std::rethrow_exception(failed);
+    // SIFT's pyramids, built afresh for each image (RunWithHeapReuse).
+    RunWithHeapReuse([&] {
+      ParallelFor(
+          static_cast<long>(with_files.size()),
+          [&](long w) {
+            images[with_files[w]] = Detect(block.images[with_files[w]], block.origin, o);
+          },
+          1, o.concurrent_images);
+    });
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {  // OpenCV's, as one of ours

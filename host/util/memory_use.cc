@@ -7,8 +7,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
 #include <fstream>
 #include <string>
+#include <system_error>
+#include <thread>
 
 namespace sapmvs {
 
@@ -79,6 +82,24 @@ ScopedHeapReuse::~ScopedHeapReuse() {
   mallopt(M_TRIM_THRESHOLD, kDefaultTrimThreshold);
 #endif
   ReleaseFreeMemory();
+}
+
+void RunWithHeapReuse(const std::function<void()>& work) {
+  const ScopedHeapReuse reuse;
+  std::exception_ptr failed;
+  auto run = [&] {
+    try {
+      work();
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  };
+  try {
+    std::thread(run).join();
+  } catch (const std::system_error&) {  // no thread to be had: on this one
+    run();
+  }
+  if (failed) std::rethrow_exception(failed);
 }
 
 bool UnwrittenMemoryIsFree() {
