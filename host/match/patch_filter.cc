@@ -78,8 +78,7 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
   // image v; false when x is behind the camera or off the image. The
   // tolerance is counted in footprints along the plane's slope: a surface
   // seen obliquely spreads its depths over a cell that much further.
-  auto locate = [&](int v, const Eigen::Vector3d& x, const Eigen::Vector3d& nx, size_t* cell,
-                    double* d, double* tol) {
+  auto cell_of = [&](int v, const Eigen::Vector3d& x, size_t* cell, double* d) {
     const Camera& cam = group.images[v].camera;
     *d = cam.Depth(x);
     if (!(*d > 0)) return false;
@@ -88,7 +87,15 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     const int cy = static_cast<int>(std::floor((uv.y() + 0.5) / cs));
     if (cx < 0 || cy < 0 || cx >= buffers[v].cols || cy >= buffers[v].rows) return false;
     *cell = static_cast<size_t>(cy) * buffers[v].cols + cx;
-    *tol = options.depth_tolerance * SlopeFootprint(cam, x, nx);
+    return true;
+  };
+  auto tolerance = [&](int v, const Eigen::Vector3d& x, const Eigen::Vector3d& nx) {
+    return options.depth_tolerance * SlopeFootprint(group.images[v].camera, x, nx);
+  };
+  auto locate = [&](int v, const Eigen::Vector3d& x, const Eigen::Vector3d& nx, size_t* cell,
+                    double* d, double* tol) {
+    if (!cell_of(v, x, cell, d)) return false;
+    *tol = tolerance(v, x, nx);
     return true;
   };
   // (image, cell, depth) of each point in each image it was matched in.
@@ -135,36 +142,48 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
   // Bytes, not vector<bool>: its elements share words, and two threads
   // writing neighbouring elements could lose one of the writes.
   std::vector<uint8_t> kept(points.size(), 0);
-#pragma omp parallel for schedule(static)
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!in(i)) continue;
-    int visible = 0;
-    bool occluding = false;
+#pragma omp parallel
+  {
+    // The images the point was matched in, cleared again after each point.
     std::vector<uint8_t> own(n, 0);
-    for_each_view(i, [&](int v, size_t cell, double d, double tol) {
-      own[v] = 1;
-      const Buffer& b = buffers[v];
-      if (d <= b.min_depth[cell] + tol) {
-        ++visible;
-        if (b.front[cell] < b.back[cell]) occluding = true;
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (!in(i)) continue;
+      const AcceptedPatch& patch = patches[points[i].patch];
+      int visible = 0;
+      bool occluding = false;
+      for_each_view(i, [&](int v, size_t cell, double d, double tol) {
+        own[v] = 1;
+        const Buffer& b = buffers[v];
+        if (d <= b.min_depth[cell] + tol) {
+          ++visible;
+          if (b.front[cell] < b.back[cell]) occluding = true;
+        }
+      });
+      // Free space: in an image the point was not matched in, a surface that
+      // image did match lying farther along the same line of sight was seen
+      // through the point, so the point floats in empty space (a window that
+      // fattened a roof over the ground beside it). It goes when those
+      // surfaces carry more support than it does. Only a cell with support
+      // whose nearest depth lies beyond the point's can count (the tolerance
+      // is >= 0), so the tolerance is computed for those alone.
+      float violated = 0;
+      if (!occluding) {
+        for (int v = 0; v < n; ++v) {
+          size_t cell = 0;
+          double d = 0;
+          if (own[v] || !cell_of(v, points[i].x, &cell, &d)) continue;
+          const Buffer& b = buffers[v];
+          if (!(b.front[cell] > 0) || !(d < b.min_depth[cell])) continue;
+          if (d < b.min_depth[cell] - tolerance(v, points[i].x, patch.normal)) {
+            violated += b.front[cell];
+          }
+        }
       }
-    });
-    // Free space: in an image the point was not matched in, a surface that
-    // image did match lying farther along the same line of sight was seen
-    // through the point, so the point floats in empty space (a window that
-    // fattened a roof over the ground beside it). It goes when those
-    // surfaces carry more support than it does.
-    float violated = 0;
-    if (!occluding) {
-      for (int v = 0; v < n; ++v) {
-        size_t cell = 0;
-        double d = 0, tol = 0;
-        if (own[v] || !locate(v, points[i].x, patches[points[i].patch].normal, &cell, &d, &tol))
-          continue;
-        if (d < buffers[v].min_depth[cell] - tol) violated += buffers[v].front[cell];
-      }
+      own[patch.ref] = 0;
+      for (const int v : patch.views) own[v] = 0;
+      kept[i] = visible >= options.min_image_num && !occluding && violated <= weight(i);
     }
-    kept[i] = visible >= options.min_image_num && !occluding && violated <= weight(i);
   }
   return std::vector<bool>(kept.begin(), kept.end());
 }
