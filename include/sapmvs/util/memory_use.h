@@ -44,8 +44,9 @@ void ReturnLargeBlocksToSystem();
 // the 2 MiB threshold. For work that allocates and frees the same large
 // buffers over and over: SIFT's pyramid, built afresh for each image, spent
 // a third of the tie points' time in the page faults of its new mappings.
-// Not for work whose peak matters more than its speed; not nested, and made
-// and ended while no other thread allocates (mallopt is process-wide).
+// Not for work whose peak matters more than its speed; not nested. mallopt
+// is process-wide: the large blocks other threads free meanwhile are kept
+// for reuse too, until the end.
 class ScopedHeapReuse {
  public:
   ScopedHeapReuse();
@@ -63,8 +64,7 @@ class ScopedHeapReuse {
 // pmvs mode by 3 to 6 MiB). What the work freed last may stay in its arena
 // (glibc trims a thread arena's top only when a block is freed there), for
 // the threads that take that arena next. Rethrows what work() throws; runs
-// it on this thread when no thread can be started. Other threads may
-// allocate meanwhile: their large blocks are then kept for reuse too.
+// it on this thread when no thread can be started.
 void RunWithHeapReuse(const std::function<void()>& work);
 
 // Whether address space reserved and never written costs nothing: true
