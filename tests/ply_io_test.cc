@@ -106,14 +106,15 @@ TEST_F(PlyIoTest, FilteredReadKeepsTheAcceptedPointsInOrder) {
   cloud.crs = "EPSG:32632";
   const fs::path path = dir_ / "cloud.ply";
   WritePly(path, cloud);
-  auto west = [](const CloudPoint& p) { return p.position.x() < 5e5; };
+  auto west = [](const Eigen::Vector3d& p) { return p.x() < 5e5; };
   PointCloud expected = cloud;
   expected.points.clear();
-  std::copy_if(cloud.points.begin(), cloud.points.end(), std::back_inserter(expected.points), west);
+  std::copy_if(cloud.points.begin(), cloud.points.end(), std::back_inserter(expected.points),
+               [&](const CloudPoint& p) { return west(p.position); });
   ASSERT_GT(expected.points.size(), 100u);
   ASSERT_LT(expected.points.size(), cloud.points.size() - 100);
   long shown = 0;
-  const PointCloud back = ReadPly(path, [&](const CloudPoint& p) {
+  const PointCloud back = ReadPly(path, [&](const Eigen::Vector3d& p) {
     ++shown;
     return west(p);
   });
@@ -416,6 +417,27 @@ TEST_F(PlyIoTest, BinaryViewsThatAreNoCountAreRefused) {
     test::ExpectInputError([&] { ReadPly(path); }, "views.ply", 0,
                            "vertex 1 of 2 (0-based): views = ");
   }
+}
+
+// A filtered read of fixed-size binary points reads no more than the
+// position of a point the filter drops (the tiled merge reads each group's
+// cloud once per tile): a bad count there goes unread, and is refused where
+// the point is kept.
+TEST_F(PlyIoTest, FilteredBinaryReadSkipsTheRestOfDroppedPoints) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+      "property float y\nproperty float z\nproperty float views\nend_header\n";
+  Bytes b(header.begin(), header.end());
+  const float v[8] = {1, 2, 3, 4, 10, 5, 6, -1.0f};
+  const uint8_t* raw = reinterpret_cast<const uint8_t*>(v);
+  b.insert(b.end(), raw, raw + sizeof v);
+  const fs::path path = dir_ / "views.ply";
+  WriteBytes(path, b);
+  const PointCloud near = ReadPly(path, [](const Eigen::Vector3d& p) { return p.x() < 5; });
+  ASSERT_EQ(near.points.size(), 1u);
+  EXPECT_EQ(near.points[0].num_views, 4);
+  test::ExpectInputError([&] { ReadPly(path, [](const Eigen::Vector3d&) { return true; }); },
+                         "views.ply", 0, "vertex 1 of 2 (0-based): views = ");
 }
 
 // Found by fuzz_ply: a float colour of NaN passed std::clamp unchanged and

@@ -73,7 +73,7 @@ std::vector<MergeSource> Sources(const GroupGrid& b) {
                    if (keep) {
                      auto& p = c.points;
                      p.erase(std::remove_if(p.begin(), p.end(),
-                                            [&](const CloudPoint& q) { return !keep(q); }),
+                                            [&](const CloudPoint& q) { return !keep(q.position); }),
                              p.end());
                    }
                    return c;

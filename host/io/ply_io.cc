@@ -350,9 +350,61 @@ std::string Ordinal(uint64_t i, const PlyElement& e) {
   return e.name + " " + std::to_string(i) + " of " + std::to_string(e.count) + " (0-based)";
 }
 
+// One property of a point, its field and value checked (Assign), else an
+// InputError naming the point.
+void AssignOrThrow(CloudPoint* p, const PlyProperty& prop, double v, const std::string& file,
+                   uint64_t i, const PlyElement& e) {
+  if (!Assign(p, prop.role, prop.type, v)) {
+    throw InputError(file, 0, Ordinal(i, e) + ": " + BadViews(v));
+  }
+}
+
+// The point's position checked, then shown to `keep`; true when it is kept.
+bool Keeps(const CloudPoint& p, const PointFilter& keep, const std::string& file, uint64_t i,
+           const PlyElement& e) {
+  if (!p.position.allFinite()) {
+    throw InputError(file, 0, "non-finite coordinate in " + Ordinal(i, e));
+  }
+  return !keep || keep(p.position);
+}
+
 void ReadBinaryElement(BinaryCursor* in, const std::string& file, const PlyElement& e, bool swap,
                        std::vector<CloudPoint>* points, const PointFilter& keep) {
+  // A point of fixed size (no list property) is taken in one piece, each
+  // property read at its offset; a filtered read loads the position first
+  // and nothing more of a point it drops. Property by property, a point cost
+  // about 100 ns, and the tiled merge reads a group's cloud once per tile.
+  struct Field {
+    size_t offset;
+    const PlyProperty* prop;
+  };
+  std::vector<Field> position, rest;
+  size_t record = 0;
+  bool fixed = points != nullptr;
+  for (const PlyProperty& prop : e.properties) {
+    if (prop.is_list) fixed = false;
+    if (prop.role == Role::kX || prop.role == Role::kY || prop.role == Role::kZ) {
+      position.push_back({record, &prop});
+    } else if (prop.role != Role::kSkip) {
+      rest.push_back({record, &prop});
+    }
+    record += TypeSize(prop.type);
+  }
   for (uint64_t i = 0; i < e.count; ++i) {
+    // A point cut short by the end of the file takes the path below, which
+    // names the property it ends in (a failed Take consumes nothing).
+    if (const uint8_t* b = fixed ? in->Take(record) : nullptr) {
+      CloudPoint p;
+      for (const Field& f : position) {
+        Assign(&p, f.prop->role, f.prop->type, LoadScalar(b + f.offset, f.prop->type, swap));
+      }
+      if (!Keeps(p, keep, file, i, e)) continue;
+      for (const Field& f : rest) {
+        AssignOrThrow(&p, *f.prop, LoadScalar(b + f.offset, f.prop->type, swap), file, i, e);
+      }
+      points->push_back(p);
+      continue;
+    }
     CloudPoint p;
     for (const PlyProperty& prop : e.properties) {
       const uint8_t* b = in->Take(TypeSize(prop.is_list ? prop.count_type : prop.type));
@@ -366,10 +418,7 @@ void ReadBinaryElement(BinaryCursor* in, const std::string& file, const PlyEleme
         }
         ok = in->Skip(static_cast<uint64_t>(n) * TypeSize(prop.type));
       } else if (ok && points && prop.role != Role::kSkip) {
-        const double v = LoadScalar(b, prop.type, swap);
-        if (!Assign(&p, prop.role, prop.type, v)) {
-          throw InputError(file, 0, Ordinal(i, e) + ": " + BadViews(v));
-        }
+        AssignOrThrow(&p, prop, LoadScalar(b, prop.type, swap), file, i, e);
       }
       if (!ok) {
         throw InputError(
@@ -377,12 +426,7 @@ void ReadBinaryElement(BinaryCursor* in, const std::string& file, const PlyEleme
             "truncated: the data ends in " + Ordinal(i, e) + ", property '" + prop.name + "'");
       }
     }
-    if (points) {
-      if (!p.position.allFinite()) {
-        throw InputError(file, 0, "non-finite coordinate in " + Ordinal(i, e));
-      }
-      if (!keep || keep(p)) points->push_back(p);
-    }
+    if (points && Keeps(p, keep, file, i, e)) points->push_back(p);
   }
 }
 
@@ -435,7 +479,7 @@ void ReadAsciiElement(TextLines* lines, const PlyElement& e, std::vector<CloudPo
       if (!p.position.allFinite()) {
         throw lines->Fail("non-finite coordinate in " + Ordinal(i, e));
       }
-      if (!keep || keep(p)) points->push_back(p);
+      if (!keep || keep(p.position)) points->push_back(p);
     }
   }
 }

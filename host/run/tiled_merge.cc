@@ -63,8 +63,8 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
   bool all_read = true;
   for (size_t g = 0; g < n; ++g) {
     long count = 0;
-    PointCloud c = groups[g].load([&](const CloudPoint& p) {
-      extent[g].Add(p.position.x(), p.position.y());
+    PointCloud c = groups[g].load([&](const Eigen::Vector3d& p) {
+      extent[g].Add(p.x(), p.y());
       ++count;
       return all_read && layout.input_points + count <= options.tile_points;
     });
@@ -128,8 +128,8 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
         if (whole) {
           clouds[g] = all_read ? std::move(read[g]) : groups[g].load(PointFilter());
         } else {
-          clouds[g] = groups[g].load(
-              [&](const CloudPoint& p) { return reach.Holds(p.position.x(), p.position.y()); });
+          clouds[g] =
+              groups[g].load([&](const Eigen::Vector3d& p) { return reach.Holds(p.x(), p.y()); });
         }
       }
       MergeStats tile_stats;

@@ -65,10 +65,13 @@ void WritePly(const std::filesystem::path& path, const PointCloud& cloud);
 // Throws sapmvs::InputError naming the file (and the header line, or the data
 // line of an ascii file) when the header is malformed, there is no vertex
 // element or no x y z, the data is truncated, or a coordinate is not finite.
-// With `keep`, only the points it returns true for are kept, in file order:
-// a caller that needs part of a large cloud never holds the rest. Each point
-// is shown to `keep` once, after it is checked.
-using PointFilter = std::function<bool(const CloudPoint&)>;
+// With `keep`, only the points whose position it returns true for are kept,
+// in file order: a caller that needs part of a large cloud never holds the
+// rest. Each point's position is shown to `keep` once, after it is checked
+// to be finite; in a binary file of fixed-size records the rest of a point
+// `keep` drops is not read (the tiled merge reads a group's cloud once per
+// tile it meets).
+using PointFilter = std::function<bool(const Eigen::Vector3d& position)>;
 PointCloud ReadPly(const std::filesystem::path& path, const PointFilter& keep = {});
 
 }  // namespace sapmvs
