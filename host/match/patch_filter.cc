@@ -74,10 +74,8 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     b.front.assign(size, 0);
     b.back.assign(size, 0);
   }
-  // Cell, depth and depth tolerance of point x on a plane of normal nx in
-  // image v; false when x is behind the camera or off the image. The
-  // tolerance is counted in footprints along the plane's slope: a surface
-  // seen obliquely spreads its depths over a cell that much further.
+  // Cell and depth of point x in image v; false when x is behind the camera
+  // or off the image.
   auto cell_of = [&](int v, const Eigen::Vector3d& x, size_t* cell, double* d) {
     const Camera& cam = group.images[v].camera;
     *d = cam.Depth(x);
@@ -89,9 +87,13 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
     *cell = static_cast<size_t>(cy) * buffers[v].cols + cx;
     return true;
   };
+  // The depth tolerance of x on a plane of normal nx in image v, counted in
+  // footprints along the plane's slope: a surface seen obliquely spreads its
+  // depths over a cell that much further.
   auto tolerance = [&](int v, const Eigen::Vector3d& x, const Eigen::Vector3d& nx) {
     return options.depth_tolerance * SlopeFootprint(group.images[v].camera, x, nx);
   };
+  // Both, for a point on a plane of normal nx.
   auto locate = [&](int v, const Eigen::Vector3d& x, const Eigen::Vector3d& nx, size_t* cell,
                     double* d, double* tol) {
     if (!cell_of(v, x, cell, d)) return false;
