@@ -268,16 +268,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   job.crs = block.crs;
   job.out = options.out;
   job.block = options.block;
-  // The merge reads each group's cloud once per tile and the writers fill
-  // their buffers afresh per tile: as new mappings, their page faults were a
-  // quarter of the merge's time (Herz-Jesu-P8: merge, statistics and writing
-  // 2.5-3.3 s against 1.6-2.2 s with the buffers reused). The matching's
-  // peak is behind; the merge's, with them kept, stays below it on `city`
-  // and Herz-Jesu-P8 and passes it by 1.5 MiB on `small`.
-  {
-    const ScopedHeapReuse reuse;
-    WriteMergedOutputs(job, &report, end_stage);
-  }
+  WriteMergedOutputs(job, &report, end_stage);
   report.finished = true;
   report.total_seconds = Since(start);
   report.peak_rss_bytes = ProcessPeakRssBytes();
