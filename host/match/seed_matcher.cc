@@ -293,8 +293,7 @@ std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
     SeedFeature& out = local[w];
     out.image = i;
     out.uv = f.uv;
-    for (const Scored& s : scored) {
-      if (static_cast<int>(out.candidates.size()) >= options.candidates_per_feature) break;
+    for (const Scored& s : scored) {  // at most `keep`, best first
       PatchCandidate c;
       c.center = s.x;
       c.normal = (ref.camera.center() - s.x).normalized();
