@@ -7,8 +7,10 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <numeric>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 namespace sapmvs {
 namespace {
@@ -75,6 +77,24 @@ TEST(MemoryUse, LargeBlocksGoBackToTheSystemWhenFreed) {
   const double held = CurrentRssBytes();
   block.reset();
   EXPECT_LE(CurrentRssBytes(), held - 0.9 * kMedium);
+}
+
+// A vector shrunk in place keeps the pages of its largest size resident until
+// its tail is handed back; what it still holds, up to the last element on a
+// partly kept page, stays as it was.
+TEST(MemoryUse, ReleasedCapacityLeavesTheRssAndKeepsTheElements) {
+  if (CurrentRssBytes() <= 0) GTEST_SKIP() << "this system does not report the RSS";
+  std::vector<int64_t> v(kBlock / sizeof(int64_t));
+  std::iota(v.begin(), v.end(), int64_t{0});
+  const size_t kept = v.size() / 4 + 3;  // ends inside a page
+  v.resize(kept);
+  const double held = CurrentRssBytes();
+  ReleaseUnusedCapacity(v);
+  EXPECT_LE(CurrentRssBytes(), held - 0.7 * kBlock);
+  for (size_t i = 0; i < kept; ++i) ASSERT_EQ(v[i], static_cast<int64_t>(i)) << "element " << i;
+  v.resize(v.capacity(), -1);  // the released tail takes elements again
+  EXPECT_EQ(v.back(), -1);
+  EXPECT_EQ(v[kept - 1], static_cast<int64_t>(kept - 1));
 }
 
 // Inside the scope a freed 8 MiB block stays resident for the next one;

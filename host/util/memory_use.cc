@@ -1,12 +1,17 @@
 #include "sapmvs/util/memory_use.h"
 
 #include <sys/resource.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <exception>
 #include <fstream>
 #include <string>
@@ -112,6 +117,20 @@ bool UnwrittenMemoryIsFree() {
   std::ifstream f("/proc/sys/vm/overcommit_memory");
   int mode = -1;
   return static_cast<bool>(f >> mode) && mode != 2;
+}
+
+void ReleasePages(void* begin, void* end) {
+#if defined(__linux__)
+  const auto page = static_cast<uintptr_t>(sysconf(_SC_PAGESIZE));
+  const uintptr_t first = (reinterpret_cast<uintptr_t>(begin) + page - 1) / page * page;
+  const uintptr_t last = reinterpret_cast<uintptr_t>(end) / page * page;
+  // MADV_DONTNEED, not MADV_FREE: the pages must leave the RSS now, before
+  // the next peak, not when the system runs short.
+  if (last > first) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+#else
+  (void)begin;
+  (void)end;
+#endif
 }
 
 void ReleaseFreeMemory() {

@@ -2,6 +2,8 @@
 // What the process holds in memory, for the reports and the memory budget.
 
 #include <functional>
+#include <type_traits>
+#include <vector>
 
 namespace sapmvs {
 
@@ -26,6 +28,19 @@ bool ResetPeakRss();
 // that what one group freed is not counted in the next group's RSS. A no-op
 // where the C library has no such call.
 void ReleaseFreeMemory();
+
+// Hands back the whole pages in [begin, end), which must lie inside one
+// allocation that holds nothing there any more; they read as zeros when
+// written again. For a container shrunk in place, whose capacity keeps the
+// pages of its largest size resident otherwise. A no-op outside Linux.
+void ReleasePages(void* begin, void* end);
+
+// ReleasePages on the capacity past a vector's size.
+template <class T, class A>
+void ReleaseUnusedCapacity(std::vector<T, A>& v) {
+  static_assert(std::is_trivially_destructible_v<T>, "the released tail holds no objects");
+  ReleasePages(v.data() + v.size(), v.data() + v.capacity());
+}
 
 // Serves every allocation of 2 MiB or more with its own mapping, which free()
 // hands straight back to the system. glibc otherwise raises that threshold
