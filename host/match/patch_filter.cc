@@ -210,13 +210,10 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   stats->removed_visibility = static_cast<long>(points.size() - alive.size()) - low;
   if (alive.empty()) return keep;
 
-  // Each point's footprint in its reference image, the unit of the plane
-  // distances below, and its neighbour radius: neighbour_radius footprints
-  // along its plane's slope, so that a surface seen obliquely, whose points
-  // lie further apart, keeps as many neighbours as one seen face-on.
-  UninitializedVector<double> footprint(alive.size());
   // nn[a * k + j]: the j-th nearest neighbour of point a within a's radius,
-  // or -1.
+  // neighbour_radius footprints along its plane's slope, so that a surface
+  // seen obliquely, whose points lie further apart, keeps as many neighbours
+  // as one seen face-on; or -1.
   const int k = kNeighbours;
   UninitializedVector<int32_t> nn;
   {
@@ -228,10 +225,19 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       const AcceptedPatch& patch = patches[p.patch];
       const Camera& camera = group.images[patch.ref].camera;
       for (int c = 0; c < 3; ++c) xyz[3 * a + c] = static_cast<float>(p.x[c]);
-      footprint[a] = Footprint(camera, p.x);
       radius[a] = options.neighbour_radius * SlopeFootprint(camera, p.x, patch.normal);
     }
     nn = NearestWithin(std::move(xyz), radius, k);
+  }
+  // Each point's footprint in its reference image, the unit of the plane
+  // distances below. Only once the search is done: beside its grid and
+  // table, the search's peak is the filter's (8 bytes a point, 9 MiB on
+  // Herz-Jesu-P8).
+  UninitializedVector<double> footprint(alive.size());
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < alive.size(); ++a) {
+    const DensePoint& p = points[alive[a]];
+    footprint[a] = Footprint(group.images[patches[p.patch].ref].camera, p.x);
   }
 
   // The distance, in footprints, from the plane of point a's patch to its
