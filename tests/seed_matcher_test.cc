@@ -265,7 +265,7 @@ std::pair<long, long> ExpectRankingAsDefined(int num_images, int keep, uint32_t 
 
   const std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
   const MatchImage& ref = group.images[0];
-  long compared = 0, supported = 0, along_x = 0, along_y = 0;
+  long compared = 0, supported = 0, supported_best = 0, along_x = 0, along_y = 0;
   for (const Feature& f : features[0]) {
     // The definition, over every feature: partners in each view, in view
     // order, then ranked.
@@ -316,12 +316,18 @@ std::pair<long, long> ExpectRankingAsDefined(int num_images, int keep, uint32_t 
     for (size_t k = 0; k < std::min(got, want.size()); ++k) {
       EXPECT_LT((found->candidates[k].center - want[k].x).norm(), 1e-9)
           << "feature at " << f.uv.transpose() << ", candidate " << k;
+      supported += want[k].support > 0;
     }
-    supported += !want.empty() && want[0].support > 0;
+    supported_best += !want.empty() && want[0].support > 0;
     ++compared;
   }
   EXPECT_EQ(compared, static_cast<long>(features[0].size()));
-  EXPECT_GT(2 * supported, static_cast<long>(features[0].size()))
+  // Kept whole, the candidates hold more supported ones than there are
+  // features; kept to a few, most features' best is supported.
+  if (keep >= 100000) {
+    EXPECT_GT(supported, static_cast<long>(features[0].size())) << "too few supported candidates";
+  }
+  EXPECT_GT(2 * supported_best, static_cast<long>(features[0].size()))
       << "too few features whose best candidate has support";
   return {along_x, along_y};
 }
