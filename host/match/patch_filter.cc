@@ -289,7 +289,12 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       const Eigen::Vector3d d = points[alive[b]].x - mean;
       cov += d * d.transpose();
     }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    // The closed form: Eigen's iterative solver was 2.5 % of Herz-Jesu-P8's
+    // CPU samples, and the filter took 0.4-0.5 s longer with it. Only a
+    // nearly isotropic neighbourhood, whose normal means nothing, may come
+    // out differently (one point of 188,360 on `small`).
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
     const Eigen::Vector3d normal = es.eigenvectors().col(0);
     pass[a] = std::abs(normal.dot(p.x - mean)) <= tolerance * fp;
   }
