@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "cli_test_util.h"
-#include "device/cl_runtime.h"
+#include "device/cl_devices.h"
 #include "sapmvs/util/error.h"
 #include "test_util.h"
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "cli_test_util.h"
-#include "device/cl_runtime.h"
+#include "device/cl_devices.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/output_folder.h"
 #include "test_util.h"

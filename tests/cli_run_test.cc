@@ -12,7 +12,7 @@
 #include <string>
 
 #include "cli_test_util.h"
-#include "device/cl_runtime.h"
+#include "device/cl_devices.h"
 #include "sapmvs/io/las_io.h"
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/io/raster_io.h"

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "device/cl_runtime.h"
+#include "device/cl_devices.h"
 #include "sapmvs/util/error.h"
 #include "test_util.h"
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "device/cl_runtime.h"
+#include "device/cl_devices.h"
 #include "match/patch_kernels.h"
 #include "sapmvs/util/error.h"
 
