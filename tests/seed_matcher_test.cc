@@ -143,6 +143,10 @@ void AddRandomFeatures(std::mt19937& rng, int n, std::vector<Feature>* out) {
   }
 }
 
+// A candidates_per_feature above any feature's partner count: every candidate
+// is kept.
+constexpr int kKeepEvery = 100000;
+
 // Seed matching searches only the features near each epipolar segment (a
 // bucket walk along it, clipped to the image): it must find exactly the
 // candidates a scan of every feature finds, including features just inside
@@ -151,7 +155,7 @@ void AddRandomFeatures(std::mt19937& rng, int n, std::vector<Feature>* out) {
 TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
   MatchGroupData group = TwoImageGroup();
   MatcherOptions options;
-  options.candidates_per_feature = 100000;  // keep every candidate
+  options.candidates_per_feature = kKeepEvery;
   std::mt19937 rng(5);
   std::vector<std::vector<Feature>> features(2);
   // Image 0: features all over it, near its borders too.
@@ -324,7 +328,7 @@ std::pair<long, long> ExpectRankingAsDefined(int num_images, int keep, uint32_t 
   EXPECT_EQ(compared, static_cast<long>(features[0].size()));
   // Kept whole, the candidates hold more supported ones than there are
   // features; kept to a few, most features' best is supported.
-  if (keep >= 100000) {
+  if (keep >= kKeepEvery) {
     EXPECT_GT(supported, static_cast<long>(features[0].size())) << "too few supported candidates";
   }
   EXPECT_GT(2 * supported_best, static_cast<long>(features[0].size()))
@@ -333,14 +337,14 @@ std::pair<long, long> ExpectRankingAsDefined(int num_images, int keep, uint32_t 
 }
 
 TEST(SeedMatcherTest, RanksCandidatesBySupportAsTheDefinitionDoes) {
-  ExpectRankingAsDefined(3, 100000, 7);  // every candidate kept
+  ExpectRankingAsDefined(3, kKeepEvery, 7);
 }
 
 // Five images: supports of 0 to 3, epipolar segments in several directions.
 // Keeping 2 of the 10-30 partners a feature has, most counts stop early.
 TEST(SeedMatcherTest, KeepsTheBestCandidatesAsTheDefinitionRanksThem) {
   long along_x = 0, along_y = 0;
-  for (const int keep : {100000, 2, 1}) {
+  for (const int keep : {kKeepEvery, 2, 1}) {
     const auto [x, y] = ExpectRankingAsDefined(5, keep, 29);
     along_x += x;
     along_y += y;
