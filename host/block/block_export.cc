@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <thread>
 
@@ -18,6 +17,7 @@
 #include "sapmvs/util/kernel_limits.h"
 #include "sapmvs/util/number_text.h"
 #include "sapmvs/util/progress.h"
+#include "util/image_codec.h"
 
 namespace sapmvs {
 namespace fs = std::filesystem;
@@ -71,8 +71,8 @@ namespace {
 // One image as it is written: where, how encoded, and its camera (pinhole,
 // at the export's level, world frame).
 struct ExportImage {
-  fs::path file;        // relative to the output folder
-  std::string encoder;  // extension naming the OpenCV encoder
+  fs::path file;  // relative to the output folder
+  ImageEncoding encoding = ImageEncoding::kPng;
   Camera camera;
   fs::path camera_file;  // pmvs: txt/NNNNNNNN.txt, relative to the output folder
 };
@@ -88,19 +88,21 @@ std::string Name8(size_t i) {
   return buf;
 }
 
-// COLMAP keeps the images' names, so they keep their format where OpenCV
-// can write it; the rest (grey PGM, JPEG 2000) become PNG, losslessly.
+// COLMAP keeps the images' names, so they keep their format where GDAL can
+// write it; the rest (grey PGM, JPEG 2000) become PNG, losslessly.
 ExportImage ColmapImage(const BlockImage& im) {
   fs::path name = fs::path(im.name).filename();
   if (!HasImageExtension(name)) name += im.path.extension();
   const std::string ext = Lower(name.extension().string());
-  static const std::map<std::string, std::string> kEncoders = {
-      {".jpg", ".jpg"},   {".jpeg", ".jpg"}, {".png", ".png"}, {".tif", ".tiff"},
-      {".tiff", ".tiff"}, {".bmp", ".bmp"},  {".ppm", ".ppm"}};
-  const auto it = kEncoders.find(ext);
+  static const std::map<std::string, ImageEncoding> kEncodings = {
+      {".jpg", ImageEncoding::kJpeg},  {".jpeg", ImageEncoding::kJpeg},
+      {".png", ImageEncoding::kPng},   {".tif", ImageEncoding::kTiff},
+      {".tiff", ImageEncoding::kTiff}, {".bmp", ImageEncoding::kBmp},
+      {".ppm", ImageEncoding::kPpm}};
+  const auto it = kEncodings.find(ext);
   ExportImage e;
-  e.encoder = it != kEncoders.end() && cv::haveImageWriter(it->second) ? it->second : ".png";
-  if (e.encoder == ".png" && ext != ".png") name.replace_extension(".png");
+  e.encoding = it != kEncodings.end() && CanEncode(it->second) ? it->second : ImageEncoding::kPng;
+  if (e.encoding == ImageEncoding::kPng && ext != ".png") name.replace_extension(".png");
   e.file = fs::path("images") / name;
   return e;
 }
@@ -116,7 +118,7 @@ std::vector<ExportImage> PlanImages(const Block& block, const ExportOptions& o) 
       // PMVS2 finds visualize/NNNNNNNN.jpg; it applies its level itself.
       e.file = fs::path("visualize") / (Name8(i) + ".jpg");
       e.camera_file = fs::path("txt") / (Name8(i) + ".txt");
-      e.encoder = ".jpg";
+      e.encoding = ImageEncoding::kJpeg;
       e.camera = im.camera.Pinhole();
     } else {
       e = ColmapImage(im);
@@ -294,7 +296,6 @@ ExportSummary ExportBlock(const Block& block, const ExportOptions& options) {
 
   const bool pmvs = options.format == ExportFormat::kPmvs;
   const bool show = options.progress && Progress::TerminalAllowsProgress();
-  const std::vector<int> jpeg = {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality};
   for (size_t i = 0; i < plan.size(); ++i) {
     const ExportImage& e = plan[i];
     if (show) {
@@ -305,10 +306,8 @@ ExportSummary ExportBlock(const Block& block, const ExportOptions& options) {
     const cv::Mat pixels =
         pmvs ? loaded.pixels
              : ResampleToLevel(loaded.pixels, options.Level(), e.camera.width(), e.camera.height());
-    std::vector<uchar> bytes;
-    if (!cv::imencode(e.encoder, pixels, bytes, e.encoder == ".jpg" ? jpeg : std::vector<int>{})) {
-      throw Error((out / e.file).string() + ": " + e.encoder + " encoding failed");
-    }
+    const std::vector<uchar> bytes =
+        EncodeImage(pixels, e.encoding, (out / e.file).string(), options.jpeg_quality);
     WriteBytesAtomically(out / e.file, bytes.data(), bytes.size());
     if (pmvs) {
       WriteTextAtomically(out / e.camera_file, PmvsCameraText(e.camera.Translated(block.origin)));

@@ -8,11 +8,11 @@
 #include <memory>
 #include <mutex>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sapmvs/util/error.h"
 #include "util/gdal_messages.h"
+#include "util/image_codec.h"
 #include "util/input_file.h"
 
 namespace sapmvs {
@@ -137,10 +137,7 @@ std::filesystem::path FindImageFile(const std::filesystem::path& folder, const s
 cv::Mat LoadImage(const BlockImage& image) {
   RequireImageFile(image.path, image.name);
   CheckJpegComplete(image.path);
-  cv::Mat pixels = cv::imread(image.path.string(), cv::IMREAD_COLOR);
-  if (pixels.empty()) {
-    throw Error(image.path.string() + ": cannot decode image (expected 8-bit RGB or grey)");
-  }
+  cv::Mat pixels = DecodeImageFile(image.path);
   if (pixels.cols != image.camera.width() || pixels.rows != image.camera.height()) {
     throw Error(image.path.string() + ": image is " + std::to_string(pixels.cols) + "x" +
                 std::to_string(pixels.rows) + " px, its camera expects " +

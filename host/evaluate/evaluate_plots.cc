@@ -7,13 +7,13 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sapmvs/evaluate/evaluate.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
+#include "util/image_codec.h"
 
 namespace sapmvs {
 namespace {
@@ -122,8 +122,7 @@ cv::Vec3b Diverging(double t) {
 }
 
 void WritePng(const std::filesystem::path& path, const cv::Mat& img) {
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", img, bytes)) throw Error(path.string() + ": PNG encoding failed");
+  const std::vector<uchar> bytes = EncodeImage(img, ImageEncoding::kPng, path.string());
   WriteStreamAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(bytes.data()),
               static_cast<std::streamsize>(bytes.size()));

@@ -21,33 +21,6 @@
 namespace sapmvs {
 namespace {
 
-// GDAL reports failures through a handler that prints to stderr. While one of
-// our calls runs, the message is kept quiet and folded into the exception
-// instead, so the user sees it once, in our one-line format; warnings become
-// detail lines (gdal_messages.h).
-class QuietGdalErrors {
- public:
-  QuietGdalErrors() {
-    CPLPushErrorHandler(GdalMessageHandler);
-    CPLErrorReset();
-  }
-  ~QuietGdalErrors() { CPLPopErrorHandler(); }
-  QuietGdalErrors(const QuietGdalErrors&) = delete;
-  QuietGdalErrors& operator=(const QuietGdalErrors&) = delete;
-
-  static bool Failed() { return CPLGetLastErrorType() >= CE_Failure; }
-  // " (GDAL: message)", or "" when GDAL said nothing.
-  static std::string Detail() {
-    const char* msg = CPLGetLastErrorMsg();
-    return msg && *msg ? std::string(" (GDAL: ") + msg + ")" : std::string();
-  }
-};
-
-struct GdalDatasetCloser {
-  void operator()(GDALDataset* ds) const { GDALClose(ds); }
-};
-using DatasetPtr = std::unique_ptr<GDALDataset, GdalDatasetCloser>;
-
 void CheckRaster(const std::filesystem::path& path, const GeoRaster& r) {
   const std::string file = path.string();
   if (r.width <= 0 || r.height <= 0) {

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <vector>
@@ -20,6 +19,7 @@
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
+#include "util/image_codec.h"
 
 namespace sapmvs {
 namespace {
@@ -260,8 +260,7 @@ DsmPictures WriteDsmPictures(const GeoRaster& dsm, const std::filesystem::path& 
   map.copyTo(img(cv::Rect(0, 0, map.cols, map.rows)));
   const double pixel = dsm.cell_size / k;
   DrawLegend(&img, map.cols, lo, hi, pixel, CrsLinearUnit(dsm.crs));
-  std::vector<uint8_t> bytes;
-  if (!cv::imencode(".png", img, bytes)) throw Error(png.string() + ": PNG encoding failed");
+  const std::vector<uint8_t> bytes = EncodeImage(img, ImageEncoding::kPng, png.string());
   WriteBytesAtomically(png, bytes.data(), bytes.size());
   WriteWorldFile(out.world_file, dsm, pixel);
   return out;

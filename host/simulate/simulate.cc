@@ -4,7 +4,6 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "sapmvs/block/camera.h"
@@ -16,6 +15,7 @@
 #include "sapmvs/util/progress.h"
 #include "simulate/sim_lidar.h"
 #include "simulate/sim_presets.h"
+#include "util/image_codec.h"
 
 namespace sapmvs {
 namespace fs = std::filesystem;
@@ -72,8 +72,7 @@ cv::Mat Render(const sim::Scene& scene, const Camera& cam, const SimulateOptions
 void WriteText(const fs::path& path, const std::string& text) { WriteTextAtomically(path, text); }
 
 void WritePng(const fs::path& path, const cv::Mat& image) {
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw Error(path.string() + ": PNG encoding failed");
+  const std::vector<uchar> bytes = EncodeImage(image, ImageEncoding::kPng, path.string());
   WriteBytesAtomically(path, bytes.data(), bytes.size());
 }
 
