@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
-  libeigen3-dev libopencv-dev libflann-dev
+  libeigen3-dev libopencv-dev libflann-dev libjpeg-dev libpng-dev
   libgdal-dev gdal-bin libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # `mpirun -np N sapmvs run` (optional: without them sapmvs builds as one process).

@@ -304,6 +304,42 @@ TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {
   EXPECT_EQ(nlohmann::json::parse(report).at("crs").at("epsg"), 32651);
 }
 
+// GDAL and the hundred libraries it loads are mapped only when a step needs
+// them (cli/gdal_module.h): the binary does not link them, and a run on PNG
+// images without a DEM loads the module only after its matching, to write
+// its rasters; its CRS is checked before, in a child process.
+TEST_F(CliRunTest, LoadsGdalOnlyForTheOutputs) {
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const auto linked = test::RunCommand(std::string("LD_TRACE_LOADED_OBJECTS=1 ") + SAPMVS_CLI_PATH);
+  ASSERT_EQ(linked.exit_code, 0) << linked.err;
+  EXPECT_NE(linked.out.find("libopencv_core"), std::string::npos) << linked.out;
+  EXPECT_EQ(linked.out.find("libgdal"), std::string::npos) << linked.out;
+  EXPECT_EQ(linked.out.find("libsapmvs_gdal"), std::string::npos) << linked.out;
+
+  // The tiny block without its DEM, which GDAL would read before the matching.
+  const fs::path sim = Block().parent_path();
+  std::istringstream in(test::Slurp(Block()));
+  std::string yaml;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("dem:", 0) == 0) continue;
+    if (line == "images: images") line = "images: " + (sim / "images").string();
+    if (line == "  file: orientation.txt") line = "  file: " + (sim / "orientation.txt").string();
+    yaml += line + "\n";
+  }
+  const fs::path block = *root_ / "no_dem" / "block.yaml";
+  fs::create_directories(block.parent_path());
+  std::ofstream(block) << yaml;
+  const auto r =
+      RunCli("run " + block.string() + " --out " + out_.string() + " -q -v", "LD_DEBUG=files");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const size_t merged = r.err.find("run: merge");
+  const size_t module = r.err.find("libsapmvs_gdal.so");
+  ASSERT_NE(merged, std::string::npos) << r.err;
+  ASSERT_NE(module, std::string::npos) << "the outputs need GDAL";
+  EXPECT_GT(module, merged) << "GDAL loaded before the matching ended";
+  EXPECT_TRUE(fs::exists(out_ / "dsm.tif"));
+}
+
 TEST_F(CliRunTest, MinImageNumTwoIsAccepted) {
   SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r =

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
@@ -13,6 +14,7 @@
 
 #include "sapmvs/util/error.h"
 #include "test_util.h"
+#include "util/gdal_image_files.h"
 
 namespace sapmvs {
 namespace {
@@ -103,6 +105,71 @@ TEST_F(ImageCodecTest, DecodesOtherWritersFilesAsOpenCvDoes) {
     const cv::Mat expected = cv::imread(file.string(), cv::IMREAD_COLOR);
     ASSERT_EQ(expected.type(), CV_8UC3);
     EXPECT_LE(MaxDifference(DecodeImageFile(file), expected), c.tolerance);
+  }
+}
+
+// JPEG and PNG are decoded by libjpeg and libpng, not GDAL (image_codec.h):
+// the same pixels and sizes as GDAL's drivers give, in every layout.
+TEST_F(ImageCodecTest, JpegAndPngDecodeAsGdalDecodesThem) {
+  const std::vector<std::pair<std::string, cv::Mat>> cases = {
+      {"colour.jpg", RandomImage(CV_8UC3, 8)},  {"grey.jpg", RandomImage(CV_8UC1, 9)},
+      {"colour.png", RandomImage(CV_8UC3, 10)}, {"alpha.png", RandomImage(CV_8UC4, 11)},
+      {"grey.png", RandomImage(CV_8UC1, 12)},   {"wide.png", RandomImage(CV_16UC3, 13)}};
+  for (const auto& [name, pixels] : cases) {
+    SCOPED_TRACE(name);
+    const fs::path file = dir_ / name;
+    ASSERT_TRUE(cv::imwrite(file.string(), pixels));
+    const cv::Mat here = DecodeImageFile(file);
+    ASSERT_EQ(here.type(), CV_8UC3);
+    // GDAL rounds 16-bit samples to 8 bits, libpng (and OpenCV) truncate.
+    EXPECT_LE(MaxDifference(here, DecodeImageWithGdal(file)), pixels.depth() == CV_16U ? 1 : 0);
+    EXPECT_EQ(ReadImageFileSize(file), ReadImageSizeWithGdal(file));
+    EXPECT_EQ(ReadImageFileSize(file), cv::Size(pixels.cols, pixels.rows));
+  }
+  // A palette PNG, as GDAL writes one.
+  GDALAllRegister();
+  const fs::path palette = dir_ / "palette.png";
+  {
+    std::unique_ptr<GDALDataset> mem(
+        GetGDALDriverManager()->GetDriverByName("MEM")->Create("", 7, 5, 1, GDT_Byte, nullptr));
+    GDALColorTable table;
+    for (int i = 0; i < 3; ++i) {
+      const GDALColorEntry e = {static_cast<short>(40 * i), 7, static_cast<short>(250 - i), 255};
+      table.SetColorEntry(i, &e);
+    }
+    ASSERT_EQ(mem->GetRasterBand(1)->SetColorTable(&table), CE_None);
+    std::vector<GByte> index(35);
+    for (int i = 0; i < 35; ++i) index[i] = static_cast<GByte>(i % 3);
+    ASSERT_EQ(mem->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 7, 5, index.data(), 7, 5, GDT_Byte, 0,
+                                              0, nullptr),
+              CE_None);
+    GDALClose(GetGDALDriverManager()->GetDriverByName("PNG")->CreateCopy(
+        palette.string().c_str(), mem.get(), FALSE, nullptr, nullptr, nullptr));
+  }
+  EXPECT_EQ(MaxDifference(DecodeImageFile(palette), DecodeImageWithGdal(palette)), 0);
+  EXPECT_EQ(DecodeImageFile(palette).at<cv::Vec3b>(0, 1), cv::Vec3b(249, 7, 40));
+}
+
+TEST_F(ImageCodecTest, CorruptJpegOrPngNamesTheFileAndTheDecoder) {
+  for (const std::string name : {"bad.jpg", "bad.png"}) {
+    SCOPED_TRACE(name);
+    const fs::path file = dir_ / name;
+    ASSERT_TRUE(cv::imwrite(file.string(), RandomImage(CV_8UC3, 14)));
+    // The header survives, the first bytes after it do not.
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(name == "bad.jpg" ? 20 : 16);
+    const std::string junk(64, '\x5a');
+    f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+    f.close();
+    try {
+      DecodeImageFile(file);
+      FAIL() << "decoded a corrupt file";
+    } catch (const Error& e) {
+      const std::string decoder = name == "bad.jpg" ? "(libjpeg: " : "(libpng: ";
+      EXPECT_NE(std::string(e.what()).find(file.string() + ": cannot decode image " + decoder),
+                std::string::npos)
+          << e.what();
+    }
   }
 }
 

@@ -1,33 +1,17 @@
 #include "sapmvs/block/image_io.h"
 
-#include <gdal_priv.h>
-
 #include <algorithm>
 #include <cctype>
 #include <fstream>
-#include <memory>
-#include <mutex>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "sapmvs/util/error.h"
-#include "util/gdal_messages.h"
 #include "util/image_codec.h"
 #include "util/input_file.h"
 
 namespace sapmvs {
 namespace {
-
-void RegisterGdalOnce() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    GDALAllRegister();
-    // Readers probe files that may not be rasters; the error text reaches the
-    // user through our own messages instead of GDAL's stderr handler, and
-    // GDAL's warnings as detail lines (-v).
-    InstallGdalMessageHandler();
-  });
-}
 
 std::string LowerExtension(const std::filesystem::path& p) {
   std::string ext = p.extension().string();
@@ -88,20 +72,10 @@ bool HasImageExtension(const std::filesystem::path& path) {
 }
 
 ImageSize ReadImageSize(const std::filesystem::path& path) {
-  RegisterGdalOnce();
   RequireImageFile(path, "");
   CheckJpegComplete(path);
-  CPLErrorReset();
-  std::unique_ptr<GDALDataset> ds(
-      GDALDataset::Open(path.string().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
-  if (!ds) {
-    const std::string detail = CPLGetLastErrorMsg();
-    throw Error(path.string() + ": not a readable image" +
-                (detail.empty()
-                     ? std::string(" (expected TIFF, JPEG, PNG, PPM/PGM, BMP or JPEG 2000)")
-                     : " (" + detail + ")"));
-  }
-  return {ds->GetRasterXSize(), ds->GetRasterYSize()};
+  const cv::Size size = ReadImageFileSize(path);
+  return {size.width, size.height};
 }
 
 std::filesystem::path FindImageFile(const std::filesystem::path& folder, const std::string& name) {

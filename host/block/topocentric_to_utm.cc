@@ -1,14 +1,12 @@
 #include "block/topocentric_to_utm.h"
 
-#include <cpl_error.h>
-#include <ogr_spatialref.h>
-
 #include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
+#include "block/ecef_to_utm.h"
 #include "sapmvs/util/error.h"
 
 namespace sapmvs {
@@ -48,14 +46,7 @@ int UtmEpsgFor(const GeoReference& point) {
   return (point.latitude >= 0 ? 32600 : 32700) + zone;
 }
 
-// ECEF -> geodetic (longitude, latitude, height) -> UTM.
-struct TopocentricToUtm::Ogr {
-  OGRSpatialReference ecef, geodetic, utm;
-  std::unique_ptr<OGRCoordinateTransformation> to_geodetic, to_utm;
-};
-
-TopocentricToUtm::TopocentricToUtm(const GeoReference& reference)
-    : reference_(reference), ogr_(std::make_unique<Ogr>()) {
+TopocentricToUtm::TopocentricToUtm(const GeoReference& reference) : reference_(reference) {
   if (const std::string p = reference.Problem(); !p.empty()) {
     throw Error("reference point: expected " + p);
   }
@@ -72,22 +63,7 @@ TopocentricToUtm::TopocentricToUtm(const GeoReference& reference)
       std::cos(lat);
   enu_to_ecef_.col(2) << std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon),
       std::sin(lat);
-
-  CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
-  Ogr& o = *ogr_;
-  if (o.ecef.importFromEPSG(4978) != OGRERR_NONE ||
-      o.geodetic.importFromEPSG(4979) != OGRERR_NONE ||
-      o.utm.importFromEPSG(epsg_) != OGRERR_NONE) {
-    throw Error("PROJ has no definition of EPSG:4978, EPSG:4979 or EPSG:" + std::to_string(epsg_) +
-                " (expected GDAL's proj.db to be installed)");
-  }
-  for (OGRSpatialReference* s : {&o.ecef, &o.geodetic, &o.utm})
-    s->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);  // longitude before latitude
-  o.to_geodetic.reset(OGRCreateCoordinateTransformation(&o.ecef, &o.geodetic));
-  o.to_utm.reset(OGRCreateCoordinateTransformation(&o.geodetic, &o.utm));
-  if (!o.to_geodetic || !o.to_utm) {
-    throw Error("PROJ cannot transform EPSG:4978 to EPSG:" + std::to_string(epsg_));
-  }
+  ecef_to_utm_ = MakeEcefToUtm(epsg_);
 }
 
 TopocentricToUtm::~TopocentricToUtm() = default;
@@ -102,15 +78,8 @@ void TopocentricToUtm::Transform(std::vector<Eigen::Vector3d>* points) const {
     y[i] = e.y();
     z[i] = e.z();
   }
-  CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
-  if (!ogr_->to_geodetic->Transform(n, x.data(), y.data(), z.data())) {
-    throw Error("PROJ failed to transform ECEF points to EPSG:4979");
-  }
-  const std::vector<double> height = z;  // the UTM CRS is 2D: heights come from here
-  if (!ogr_->to_utm->Transform(n, x.data(), y.data(), z.data())) {
-    throw Error("PROJ failed to transform points to EPSG:" + std::to_string(epsg_));
-  }
-  for (size_t i = 0; i < n; ++i) (*points)[i] = Eigen::Vector3d(x[i], y[i], height[i]);
+  ecef_to_utm_->Transform(&x, &y, &z);
+  for (size_t i = 0; i < n; ++i) (*points)[i] = Eigen::Vector3d(x[i], y[i], z[i]);
 }
 
 Eigen::Vector3d TopocentricToUtm::Transform(const Eigen::Vector3d& enu) const {

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "block/ecef_to_utm.h"
 #include "sapmvs/block/block.h"
 
 namespace sapmvs {
@@ -61,12 +62,11 @@ class TopocentricToUtm {
   Eigen::Matrix3d LocalRotation(const Eigen::Vector3d& enu, double* scale = nullptr) const;
 
  private:
-  struct Ogr;
   GeoReference reference_;
   int epsg_ = 0;
   Eigen::Vector3d origin_ecef_;
   Eigen::Matrix3d enu_to_ecef_;
-  std::unique_ptr<Ogr> ogr_;
+  std::unique_ptr<EcefToUtm> ecef_to_utm_;
 };
 
 struct TopocentricToUtmReport {

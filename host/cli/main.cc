@@ -10,17 +10,17 @@
 #include <iostream>
 
 #include "cli/cli.h"
+#include "cli/gdal_module.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/log.h"
 #include "sapmvs/util/memory_use.h"
 #include "util/build_info.h"
-#include "util/gdal_messages.h"
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == sapmvs::kCheckCrsArgument) {
+    return sapmvs::CheckCrsMain(argv[2]);
+  }
   sapmvs::ReturnLargeBlocksToSystem();
-  // Before anything can reach GDAL: its warnings are detail lines, its
-  // failures part of our own messages.
-  sapmvs::InstallGdalMessageHandler();
   CLI::App app{"sapmvs: dense image matching (IG-SAPMVS) for UAV and aerial blocks on OpenCL"};
   app.set_version_flag("--version", std::string("sapmvs ") + sapmvs::BuildVersion() + " (commit " +
                                         sapmvs::BuildCommit() + ")");

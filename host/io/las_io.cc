@@ -1,7 +1,5 @@
 #include "sapmvs/io/las_io.h"
 
-#include <ogr_spatialref.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -172,25 +170,17 @@ void AppendVlr(const std::filesystem::path& path, const char* user_id, uint16_t 
 // GeoTIFF keys (the GeoKeyDirectoryTag, LAS 1.2's way to give the CRS) for a
 // CRS with an EPSG code, projected or geographic, with its vertical CRS when
 // that has one; empty for any other CRS, which then has only its WKT.
-std::vector<uint8_t> GeoKeys(const std::string& wkt) {
-  OGRSpatialReference srs;
-  if (wkt.empty() || srs.importFromWkt(wkt.c_str()) != OGRERR_NONE) return {};
-  const bool projected = srs.IsProjected();
-  const char* horizontal = projected ? "PROJCS" : srs.IsGeographic() ? "GEOGCS" : nullptr;
-  if (horizontal == nullptr) return {};
-  auto code = [&](const char* node) -> int {
-    const char* authority = srs.GetAuthorityName(node);
-    const char* c = srs.GetAuthorityCode(node);
-    return authority && c && std::strcmp(authority, "EPSG") == 0 ? std::atoi(c) : 0;
-  };
-  const int h = code(horizontal);
+std::vector<uint8_t> GeoKeys(const WktFacts& crs) {
+  const bool projected = crs.projected;
+  if (!projected && !crs.geographic) return {};
+  const int h = crs.horizontal_epsg;
   if (h <= 0 || h > 65535) return {};
   // {key, location 0 = the value itself, count 1, value}, by key.
   std::vector<std::array<uint16_t, 4>> keys = {
       {1024, 0, 1, static_cast<uint16_t>(projected ? 1 : 2)},  // GTModelType
       {1025, 0, 1, 1},                                         // GTRasterType: PixelIsArea
       {static_cast<uint16_t>(projected ? 3072 : 2048), 0, 1, static_cast<uint16_t>(h)}};
-  if (const int v = code("VERT_CS"); v > 0 && v <= 65535) {
+  if (const int v = crs.vertical_epsg; v > 0 && v <= 65535) {
     keys.push_back({4096, 0, 1, static_cast<uint16_t>(v)});  // VerticalCSType
   }
   std::vector<uint8_t> out(8 * (keys.size() + 1));
@@ -347,12 +337,8 @@ void WriteLasStream(const std::filesystem::path& path, const LasCounts& counts,
                 " points; LAS 1.2 holds at most 4294967295 (use LAS 1.4)");
   }
   const std::string wkt = CrsToWkt(options.crs);
-  bool geographic = false;
-  if (!wkt.empty()) {
-    OGRSpatialReference srs;
-    geographic = srs.importFromWkt(wkt.c_str()) == OGRERR_NONE && srs.IsGeographic();
-  }
-  Quantization q = ChooseQuantization(path, counts, options.scale, geographic);
+  const WktFacts facts = wkt.empty() ? WktFacts{} : ReadWktFacts(wkt);
+  Quantization q = ChooseQuantization(path, counts, options.scale, facts.geographic);
   // The stored (quantized) extent: quantizing and back is monotonic, so the
   // extremes of the stored coordinates are those of the given ones.
   for (int a = 0; a < 3 && counts.count > 0; ++a) {
@@ -365,7 +351,7 @@ void WriteLasStream(const std::filesystem::path& path, const LasCounts& counts,
   std::vector<uint8_t> vlrs;
   uint32_t vlr_count = 0;
   if (options.version == LasVersion::k12) {
-    if (const std::vector<uint8_t> keys = GeoKeys(wkt); !keys.empty()) {
+    if (const std::vector<uint8_t> keys = GeoKeys(facts); !keys.empty()) {
       AppendVlr(path, kProjectionUserId, kGeoKeyRecordId, "GeoTIFF GeoKeyDirectoryTag", keys,
                 &vlrs);
       ++vlr_count;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <sstream>
@@ -138,11 +139,6 @@ void CommitTiff(const std::filesystem::path& path,
 
 }  // namespace
 
-bool GeoRaster::IsEmpty(int col, int row) const {
-  const float v = at(col, row);
-  return std::isnan(v) || v == nodata;
-}
-
 std::string CrsToWkt(const std::string& crs) {
   if (crs.empty()) return "";
   QuietGdalErrors quiet;
@@ -160,6 +156,8 @@ std::string CrsToWkt(const std::string& crs) {
   }
   return out;
 }
+
+void CheckCrs(const std::string& crs) { CrsToWkt(crs); }
 
 CrsIdentity IdentifyCrs(const std::string& crs) {
   QuietGdalErrors quiet;
@@ -203,6 +201,23 @@ void WriteColorGeoTiff(const std::filesystem::path& path, const GeoRaster& grid,
   CommitTiff(path, [&](const std::filesystem::path& tmp) {
     WriteRgbaTiff(path.string(), tmp, grid, grid.crs.empty() ? nullptr : &srs, rgba);
   });
+}
+
+WktFacts ReadWktFacts(const std::string& wkt) {
+  WktFacts facts;
+  OGRSpatialReference srs;
+  if (wkt.empty() || srs.importFromWkt(wkt.c_str()) != OGRERR_NONE) return facts;
+  facts.projected = srs.IsProjected();
+  facts.geographic = srs.IsGeographic();
+  auto code = [&](const char* node) -> int {
+    const char* authority = srs.GetAuthorityName(node);
+    const char* c = srs.GetAuthorityCode(node);
+    return authority && c && std::strcmp(authority, "EPSG") == 0 ? std::atoi(c) : 0;
+  };
+  const char* horizontal = facts.projected ? "PROJCS" : facts.geographic ? "GEOGCS" : nullptr;
+  if (horizontal) facts.horizontal_epsg = code(horizontal);
+  facts.vertical_epsg = code("VERT_CS");
+  return facts;
 }
 
 std::string CrsLinearUnit(const std::string& crs) {

@@ -130,7 +130,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
 
   const Block block = ReadBlock(options.block, options.read);
   try {
-    CrsToWkt(block.crs);  // what cloud.las and dsm.tif will need, after all the matching
+    CheckCrs(block.crs);  // what cloud.las and dsm.tif will need, after all the matching
   } catch (const Error& e) {
     throw Error(block.source.string() + ": " + e.what());
   }

@@ -1,152 +1,192 @@
 #include "util/image_codec.h"
 
-#include <cpl_vsi.h>
-#include <gdal_priv.h>
+#include <png.h>
+#include <stdio.h>
+// clang-format off: jpeglib.h needs stdio.h's FILE first.
+#include <jpeglib.h>
+// clang-format on
 
-#include <atomic>
-#include <mutex>
+#include <cerrno>
+#include <csetjmp>
+#include <cstring>
+#include <fstream>
 #include <opencv2/core.hpp>
 
 #include "sapmvs/util/error.h"
-#include "util/gdal_messages.h"
+#include "util/gdal_image_files.h"
 
 namespace sapmvs {
 namespace {
 
-void RegisterDriversOnce() {
-  static std::once_flag once;
-  std::call_once(once, [] { GDALAllRegister(); });
+// JPEG and PNG, the formats of UAV cameras and of the simulator, are decoded
+// here with libjpeg-turbo and libpng, so that a run on them never loads GDAL
+// (cli/gdal_module.h); the rest goes through GDAL's drivers.
+enum class Format { kJpeg, kPng, kOther };
+
+Format Sniff(const std::filesystem::path& path) {
+  unsigned char head[8] = {};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(head), sizeof(head));
+  if (in.gcount() >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF) {
+    return Format::kJpeg;
+  }
+  if (in.gcount() == 8 && png_sig_cmp(head, 0, 8) == 0) return Format::kPng;
+  return Format::kOther;
 }
 
-const char* DriverName(ImageEncoding encoding) {
-  switch (encoding) {
-    case ImageEncoding::kPng:
-      return "PNG";
-    case ImageEncoding::kJpeg:
-      return "JPEG";
-    case ImageEncoding::kTiff:
-      return "GTiff";
-    case ImageEncoding::kBmp:
-      return "BMP";
-    case ImageEncoding::kPpm:
-      return "PNM";
+// Closes the file on every way out, longjmp included (it is a plain pointer
+// set before setjmp).
+struct File {
+  explicit File(const std::filesystem::path& path) : f(std::fopen(path.c_str(), "rb")) {
+    if (!f) {
+      throw Error(path.string() + ": cannot open image (" + std::strerror(errno) + ")");
+    }
   }
-  return "";
+  ~File() { std::fclose(f); }
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
+  FILE* f;
+};
+
+struct JpegError {
+  jpeg_error_mgr manager;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+void OnJpegError(j_common_ptr info) {
+  auto* e = reinterpret_cast<JpegError*>(info->err);
+  (*info->err->format_message)(info, e->message);
+  std::longjmp(e->jump, 1);
 }
 
-// A palette image's indices looked up in its colour table.
-cv::Mat ExpandPalette(GDALRasterBand* band, const std::string& file) {
-  const GDALColorTable* table = band->GetColorTable();
-  if (!table) throw Error(file + ": palette image without a colour table");
-  const int w = band->GetXSize(), h = band->GetYSize();
-  cv::Mat index(h, w, CV_8UC1);
-  if (band->RasterIO(GF_Read, 0, 0, w, h, index.data, w, h, GDT_Byte, 1,
-                     static_cast<GSpacing>(index.step), nullptr) != CE_None) {
-    throw Error(file + ": cannot decode image" + QuietGdalErrors::Detail());
+// Corrupt data is a warning to libjpeg, which then decodes what it can;
+// OpenCV and GDAL accept such files as well. A truncated file is refused
+// before (image_io.cc).
+void IgnoreJpegMessage(j_common_ptr /*info*/, int /*level*/) {}
+
+enum class Decoded { kDone, kFailed, kNotHere };
+
+// Decodes into `pixels` (8-bit BGR) or, when `pixels` is null, reads the size
+// only. No C++ object with a destructor lives between setjmp and longjmp.
+Decoded DecodeJpeg(FILE* f, cv::Mat* pixels, cv::Size* size, std::string* error) {
+  jpeg_decompress_struct info;
+  JpegError err;
+  info.err = jpeg_std_error(&err.manager);
+  err.manager.error_exit = OnJpegError;
+  err.manager.emit_message = IgnoreJpegMessage;
+  if (setjmp(err.jump)) {
+    jpeg_destroy_decompress(&info);
+    *error = err.message;
+    return Decoded::kFailed;
   }
-  cv::Vec3b lut[256] = {};
-  for (int i = 0; i < std::min(256, table->GetColorEntryCount()); ++i) {
-    const GDALColorEntry* c = table->GetColorEntry(i);
-    lut[i] =
-        cv::Vec3b(static_cast<uchar>(c->c3), static_cast<uchar>(c->c2), static_cast<uchar>(c->c1));
+  jpeg_create_decompress(&info);
+  jpeg_stdio_src(&info, f);
+  jpeg_read_header(&info, TRUE);
+  *size = cv::Size(static_cast<int>(info.image_width), static_cast<int>(info.image_height));
+  // libjpeg cannot turn CMYK into RGB; GDAL can.
+  const bool cmyk = info.jpeg_color_space == JCS_CMYK || info.jpeg_color_space == JCS_YCCK;
+  if (!pixels || cmyk) {
+    jpeg_destroy_decompress(&info);
+    return pixels ? Decoded::kNotHere : Decoded::kDone;
   }
-  cv::Mat out(h, w, CV_8UC3);
-  for (int r = 0; r < h; ++r) {
-    const uchar* in = index.ptr<uchar>(r);
-    cv::Vec3b* o = out.ptr<cv::Vec3b>(r);
-    for (int c = 0; c < w; ++c) o[c] = lut[in[c]];
+  info.out_color_space = JCS_EXT_BGR;
+  jpeg_start_decompress(&info);
+  pixels->create(size->height, size->width, CV_8UC3);
+  while (info.output_scanline < info.output_height) {
+    JSAMPROW row = pixels->ptr<JSAMPLE>(static_cast<int>(info.output_scanline));
+    jpeg_read_scanlines(&info, &row, 1);
   }
-  return out;
+  jpeg_finish_decompress(&info);
+  jpeg_destroy_decompress(&info);
+  return Decoded::kDone;
+}
+
+struct PngError {
+  char message[256];
+};
+
+void OnPngError(png_structp png, png_const_charp message) {
+  auto* e = static_cast<PngError*>(png_get_error_ptr(png));
+  std::snprintf(e->message, sizeof(e->message), "%s", message);
+  png_longjmp(png, 1);
+}
+
+void IgnorePngWarning(png_structp /*png*/, png_const_charp /*message*/) {}
+
+// As DecodeJpeg. The transformations give what OpenCV's imread gave: 16-bit
+// samples keep their high byte, a palette and low bit depths are expanded,
+// grey is repeated, alpha dropped, no gamma applied.
+Decoded DecodePng(FILE* f, cv::Mat* pixels, cv::Size* size, std::string* error) {
+  PngError err{};
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, OnPngError, IgnorePngWarning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!info) {
+    png_destroy_read_struct(&png, nullptr, nullptr);
+    *error = "out of memory";
+    return Decoded::kFailed;
+  }
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    *error = err.message;
+    return Decoded::kFailed;
+  }
+  png_init_io(png, f);
+  png_read_info(png, info);
+  *size = cv::Size(static_cast<int>(png_get_image_width(png, info)),
+                   static_cast<int>(png_get_image_height(png, info)));
+  if (!pixels) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return Decoded::kDone;
+  }
+  const int type = png_get_color_type(png, info);
+  const int depth = png_get_bit_depth(png, info);
+  if (depth == 16) png_set_strip_16(png);
+  if (type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+  if (type == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+  if (type & PNG_COLOR_MASK_ALPHA) png_set_strip_alpha(png);
+  if (type == PNG_COLOR_TYPE_GRAY || type == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(png);
+  png_set_bgr(png);
+  png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  pixels->create(size->height, size->width, CV_8UC3);
+  std::vector<png_bytep> rows(static_cast<size_t>(size->height));
+  for (int r = 0; r < size->height; ++r) rows[static_cast<size_t>(r)] = pixels->ptr<png_byte>(r);
+  png_read_image(png, rows.data());
+  png_read_end(png, nullptr);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return Decoded::kDone;
+}
+
+// Decodes (pixels non-null) or reads the size; false when GDAL is to.
+bool DecodeHere(const std::filesystem::path& path, cv::Mat* pixels, cv::Size* size) {
+  const Format format = Sniff(path);
+  if (format == Format::kOther) return false;
+  File file(path);
+  std::string error;
+  const Decoded d = format == Format::kJpeg ? DecodeJpeg(file.f, pixels, size, &error)
+                                            : DecodePng(file.f, pixels, size, &error);
+  if (d == Decoded::kFailed) {
+    throw Error(path.string() + ": cannot decode image (" +
+                (format == Format::kJpeg ? "libjpeg: " : "libpng: ") + error + ")");
+  }
+  return d == Decoded::kDone;
 }
 
 }  // namespace
 
 cv::Mat DecodeImageFile(const std::filesystem::path& path) {
-  RegisterDriversOnce();
-  const std::string file = path.string();
-  QuietGdalErrors quiet;
-  DatasetPtr ds(GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
-  if (!ds || ds->GetRasterCount() < 1) {
-    throw Error(file + ": cannot decode image" + quiet.Detail() +
-                " (expected TIFF, JPEG, PNG, PPM/PGM, BMP or JPEG 2000)");
-  }
-  GDALRasterBand* first = ds->GetRasterBand(1);
-  const GDALDataType type = first->GetRasterDataType();
-  if (type != GDT_Byte && type != GDT_UInt16) {
-    throw Error(file + ": " + GDALGetDataTypeName(type) +
-                " samples, expected 8-bit or 16-bit unsigned integers");
-  }
-  if (first->GetColorInterpretation() == GCI_PaletteIndex && type == GDT_Byte) {
-    return ExpandPalette(first, file);
-  }
-  const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize();
-  // OpenCV's order: blue, green, red; grey (with or without alpha) thrice.
-  int bands[3] = {3, 2, 1};
-  if (ds->GetRasterCount() < 3) bands[0] = bands[1] = bands[2] = 1;
-  const bool wide = type == GDT_UInt16;
-  cv::Mat pixels(h, w, wide ? CV_16UC3 : CV_8UC3);
-  const GSpacing sample = wide ? 2 : 1;
-  if (ds->RasterIO(GF_Read, 0, 0, w, h, pixels.data, w, h, type, 3, bands, 3 * sample,
-                   static_cast<GSpacing>(pixels.step), sample, nullptr) != CE_None) {
-    throw Error(file + ": cannot decode image" + quiet.Detail());
-  }
-  if (wide) pixels.convertTo(pixels, CV_8U, 1.0 / 256.0);
-  return pixels;
+  cv::Mat pixels;
+  cv::Size size;
+  if (DecodeHere(path, &pixels, &size)) return pixels;
+  return DecodeImageWithGdal(path);
 }
 
-std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encoding,
-                                       const std::string& what, int jpeg_quality) {
-  RegisterDriversOnce();
-  if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
-    throw Error(what + ": cannot encode image (expected 8-bit BGR or grey pixels)");
-  }
-  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(DriverName(encoding));
-  if (!mem || !driver) {
-    throw Error(what + ": cannot encode image (GDAL has no " + DriverName(encoding) + " driver)");
-  }
-  QuietGdalErrors quiet;
-  const int n = image.channels();
-  DatasetPtr src(mem->Create("", image.cols, image.rows, n, GDT_Byte, nullptr));
-  int bands[3] = {3, 2, 1};
-  if (n == 1) bands[0] = 1;
-  if (!src || src->RasterIO(GF_Write, 0, 0, image.cols, image.rows, const_cast<uchar*>(image.data),
-                            image.cols, image.rows, GDT_Byte, n, bands, n,
-                            static_cast<GSpacing>(image.step), 1, nullptr) != CE_None) {
-    throw Error(what + ": cannot encode image" + quiet.Detail());
-  }
-  if (n == 3) {
-    src->GetRasterBand(1)->SetColorInterpretation(GCI_RedBand);
-    src->GetRasterBand(2)->SetColorInterpretation(GCI_GreenBand);
-    src->GetRasterBand(3)->SetColorInterpretation(GCI_BlueBand);
-  }
-  // Encoded in GDAL's in-memory file system; the name is unique per call so
-  // threads encoding at once do not share a file.
-  static std::atomic<unsigned long> serial{0};
-  const std::string name = "/vsimem/sapmvs_encode_" + std::to_string(serial++);
-  const std::string quality = "QUALITY=" + std::to_string(jpeg_quality);
-  char* jpeg_options[] = {const_cast<char*>(quality.c_str()), nullptr};
-  char* tiff_options[] = {const_cast<char*>("COMPRESS=LZW"), nullptr};
-  char** options = encoding == ImageEncoding::kJpeg   ? jpeg_options
-                   : encoding == ImageEncoding::kTiff ? tiff_options
-                                                      : nullptr;
-  DatasetPtr out(driver->CreateCopy(name.c_str(), src.get(), FALSE, options, nullptr, nullptr));
-  const bool written = out != nullptr;
-  out.reset();  // closing writes the last of the file
-  VSIUnlink((name + ".aux.xml").c_str());
-  vsi_l_offset length = 0;
-  GByte* data = VSIGetMemFileBuffer(name.c_str(), &length, TRUE);
-  std::vector<unsigned char> bytes(data, data + (data ? length : 0));
-  CPLFree(data);
-  if (!written || bytes.empty() || QuietGdalErrors::Failed()) {
-    throw Error(what + ": cannot encode image as " + DriverName(encoding) + quiet.Detail());
-  }
-  return bytes;
-}
-
-bool CanEncode(ImageEncoding encoding) {
-  RegisterDriversOnce();
-  return GetGDALDriverManager()->GetDriverByName(DriverName(encoding)) != nullptr;
+cv::Size ReadImageFileSize(const std::filesystem::path& path) {
+  cv::Size size;
+  if (DecodeHere(path, nullptr, &size)) return size;
+  return ReadImageSizeWithGdal(path);
 }
 
 }  // namespace sapmvs

@@ -1,8 +1,10 @@
 #pragma once
 // North-up single-band float rasters (DSMs, DEMs, error maps) in and out of
-// GeoTIFF through GDAL, and the CRS conversion the point writers share.
+// GeoTIFF through GDAL, and the CRS conversion the point writers share. The
+// functions are GDAL code, in the GDAL module (cli/gdal_module.h).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
 #include <limits>
@@ -27,7 +29,10 @@ struct GeoRaster {
 
   float& at(int col, int row) { return values[static_cast<size_t>(row) * width + col]; }
   float at(int col, int row) const { return values[static_cast<size_t>(row) * width + col]; }
-  bool IsEmpty(int col, int row) const;
+  bool IsEmpty(int col, int row) const {
+    const float v = at(col, row);
+    return std::isnan(v) || v == nodata;
+  }
   // World (x, y) of the centre of cell (col, row).
   Eigen::Vector2d CellCenter(int col, int row) const {
     return {origin_x + (col + 0.5) * cell_size, origin_y - (row + 0.5) * cell_size};
@@ -55,6 +60,11 @@ GeoRaster ReadGeoRaster(const std::filesystem::path& path);
 // Converts a CRS given as WKT, "EPSG:n" or a PROJ string (no network look-up)
 // to OGR's default WKT; "" stays "". Throws sapmvs::Error naming the text.
 std::string CrsToWkt(const std::string& crs);
+// Throws as CrsToWkt when `crs` would fail it, so that a run refuses a bad
+// CRS before its matching. The binary checks in a child process
+// (cli/gdal_module.cc): a run whose images need no GDAL loads it only for
+// its outputs, after the matching's peak of memory.
+void CheckCrs(const std::string& crs);
 
 // How a report names a CRS: its EPSG code (0 when it has none that PROJ can
 // find without the network) and its name ("WGS 84 / UTM zone 32N").
@@ -64,6 +74,16 @@ struct CrsIdentity {
 };
 // `crs` as CrsToWkt takes it, not empty. Throws sapmvs::Error naming the text.
 CrsIdentity IdentifyCrs(const std::string& crs);
+// What LAS needs to know of a CRS given as WKT: its kind and the EPSG codes
+// of its horizontal and vertical parts (0 where none is given). All false and
+// 0 for text GDAL cannot read.
+struct WktFacts {
+  bool projected = false;
+  bool geographic = false;
+  int horizontal_epsg = 0;
+  int vertical_epsg = 0;
+};
+WktFacts ReadWktFacts(const std::string& wkt);
 // The CRS's horizontal unit as an axis label: "m", "ft", "ftUS", "deg" for a
 // geographic CRS, another unit's name; "" without a CRS or for one that
 // cannot be read.
