@@ -35,7 +35,7 @@ void WriteBytes(const fs::path& path, const Bytes& b) {
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), b.size());
 }
 
-void WriteText(const fs::path& path, const std::string& text) {
+void WritePlyText(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
@@ -129,7 +129,7 @@ TEST_F(PlyIoTest, FilteredReadKeepsTheAcceptedPointsInOrder) {
   ExpectSamePoints(expected, back);
 
   const fs::path ascii = dir_ / "hand.ply";
-  WriteText(ascii,
+  WritePlyText(ascii,
             "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
             "property float z\nend_header\n-1 0 0\n6e5 0 0\n-3 0 0\n7e5 0 0\n");
   const PointCloud a = ReadPly(ascii, west);
@@ -205,7 +205,7 @@ TEST_F(PlyIoTest, OnlyCoordinatesWhenNoOptionalField) {
 
 TEST_F(PlyIoTest, ReadsAsciiBuiltByHand) {
   const fs::path path = dir_ / "hand.ply";
-  WriteText(path,
+  WritePlyText(path,
             "ply\r\n"
             "format ascii 1.0\r\n"
             "comment made by hand\r\n"
@@ -302,7 +302,7 @@ TEST_F(PlyIoTest, ReadsBigEndianBuiltByHand) {
 // sapmvs writes them; the big-endian test above reads the plain names.
 TEST_F(PlyIoTest, ScalarPrefixedScoreAndViewsAreRead) {
   const fs::path path = dir_ / "cc.ply";
-  WriteText(path,
+  WritePlyText(path,
             "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
             "property double z\nproperty float scalar_score\nproperty float scalar_views\n"
             "end_header\n1 2 3 0.5 4\n4 5 6 -0.25 7\n");
@@ -349,7 +349,7 @@ TEST_F(PlyIoTest, MalformedHeadersNameTheLine) {
   for (const auto& m : cases) {
     SCOPED_TRACE(m.name);
     const fs::path path = dir_ / "bad.ply";
-    WriteText(path, m.text);
+    WritePlyText(path, m.text);
     test::ExpectInputError([&] { ReadPly(path); }, "bad.ply", m.line, m.expect);
   }
 }
@@ -368,7 +368,7 @@ TEST_F(PlyIoTest, MalformedAsciiDataNamesTheLine) {
   for (const auto& m : cases) {
     SCOPED_TRACE(m.name);
     const fs::path path = dir_ / "bad.ply";
-    WriteText(path, m.text);
+    WritePlyText(path, m.text);
     test::ExpectInputError([&] { ReadPly(path); }, "bad.ply", m.line, m.expect);
   }
 }
