@@ -195,6 +195,25 @@ TEST_F(CliOutputTest, InvalidCrsIsRefusedBeforeAnyWork) {
   EXPECT_TRUE(NoOutput());
 }
 
+// The DSM rasters need the GDAL module (cli/gdal_module.h), which the binary
+// loads only then: a binary without it refuses the run before any work, as
+// it refuses a bad CRS.
+TEST_F(CliOutputTest, MissingGdalModuleIsRefusedBeforeAnyWork) {
+  const fs::path bin = *root_ / "bin_without_module";
+  fs::create_directories(bin);
+  std::error_code ec;
+  fs::create_hard_link(test::CliPath(), bin / "sapmvs", ec);
+  if (ec) fs::copy_file(test::CliPath(), bin / "sapmvs");
+  ASSERT_FALSE(fs::exists(bin / "libsapmvs_gdal.so"));
+  const auto r = test::RunCommand((bin / "sapmvs").string() + " " + Run(Block(), out_));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "sapmvs: libsapmvs_gdal.so: cannot load the GDAL module (" +
+                       (bin / "libsapmvs_gdal.so").string() + " and " +
+                       (*root_ / "lib" / "sapmvs" / "libsapmvs_gdal.so").string() +
+                       " missing; expected it beside the sapmvs binary or in ../lib/sapmvs)\n");
+  EXPECT_TRUE(NoOutput());
+}
+
 TEST_F(CliOutputTest, MissingProfileFolderIsRefusedBeforeAnyWork) {
   const fs::path csv = *root_ / "no_such_folder" / "profile.csv";
   const auto r = RunCli(Run(NoBlock(), out_, "--profile " + csv.string()));

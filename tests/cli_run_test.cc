@@ -310,7 +310,7 @@ TEST_F(CliRunTest, OdmProjectOutputsCarryItsEpsgCode) {
 // its rasters; its CRS is checked before, in a child process.
 TEST_F(CliRunTest, LoadsGdalOnlyForTheOutputs) {
   SAPMVS_REQUIRE_OPENCL_DEVICE();
-  const auto linked = test::RunCommand(std::string("LD_TRACE_LOADED_OBJECTS=1 ") + SAPMVS_CLI_PATH);
+  const auto linked = test::RunCommand("LD_TRACE_LOADED_OBJECTS=1 " + test::CliPath().string());
   ASSERT_EQ(linked.exit_code, 0) << linked.err;
   EXPECT_NE(linked.out.find("libopencv_core"), std::string::npos) << linked.out;
   EXPECT_EQ(linked.out.find("libgdal"), std::string::npos) << linked.out;

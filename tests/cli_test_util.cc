@@ -32,6 +32,8 @@ CliResult RunCommand(const std::string& command) {
   return r;
 }
 
+std::filesystem::path CliPath() { return SAPMVS_CLI_PATH; }
+
 CliResult RunCli(const std::string& args, const std::string& env) {
   return RunCommand(env + (env.empty() ? "" : " ") + SAPMVS_CLI_PATH + " " + args);
 }

@@ -18,6 +18,9 @@ struct CliResult {
 // stderr.
 CliResult RunCommand(const std::string& command);
 
+// The built `sapmvs` binary.
+std::filesystem::path CliPath();
+
 // Runs `env sapmvs args` through the shell; `env` is a prefix such as
 // "OCL_ICD_VENDORS=/tmp/none" (may be empty).
 CliResult RunCli(const std::string& args, const std::string& env = "");

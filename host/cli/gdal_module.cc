@@ -22,41 +22,43 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const GdalModuleFunctions* LoadModule() {
+// The module's file, beside the binary or in ../lib/sapmvs; throws naming
+// both places when it is in neither.
+fs::path FindModule() {
   constexpr const char* kName = "libsapmvs_gdal.so";
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (ec)
+  if (ec) {
     throw Error(std::string(kName) + ": cannot find the sapmvs binary's folder (" + ec.message() +
                 ")");
-  const fs::path candidates[] = {exe.parent_path() / kName,
-                                 exe.parent_path() / ".." / "lib" / "sapmvs" / kName};
-  std::string tried;
-  for (const fs::path& file : candidates) {
-    if (!fs::exists(file, ec)) {
-      tried += (tried.empty() ? "" : ", ") + file.lexically_normal().string() + " missing";
-      continue;
-    }
-    // Never closed: the tables, vtables and GDAL's state live as long as the
-    // process.
-    void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
-    if (!handle) {
-      tried += (tried.empty() ? "" : ", ") + std::string(dlerror());
-      continue;
-    }
-    using Entry = const GdalModuleFunctions* (*)();
-    auto entry = reinterpret_cast<Entry>(dlsym(handle, "sapmvs_gdal_module"));
-    const GdalModuleFunctions* table = entry ? entry() : nullptr;
-    if (!table || table->version != kGdalModuleVersion ||
-        table->size != sizeof(GdalModuleFunctions)) {
-      throw Error(file.string() +
-                  ": not this build's GDAL module (expected the libsapmvs_gdal.so built with "
-                  "this sapmvs; rebuild or reinstall)");
-    }
-    return table;
   }
-  throw Error(std::string(kName) + ": cannot load the GDAL module (" + tried +
-              "; expected it beside the sapmvs binary or in ../lib/sapmvs)");
+  const fs::path candidates[] = {
+      exe.parent_path() / kName,
+      (exe.parent_path() / ".." / "lib" / "sapmvs" / kName).lexically_normal()};
+  for (const fs::path& file : candidates) {
+    if (fs::is_regular_file(file, ec)) return file;
+  }
+  throw Error(std::string(kName) + ": cannot load the GDAL module (" + candidates[0].string() +
+              " and " + candidates[1].string() +
+              " missing; expected it beside the sapmvs binary or in ../lib/sapmvs)");
+}
+
+const GdalModuleFunctions* LoadModule() {
+  const fs::path file = FindModule();
+  // Never closed: the table, vtables and GDAL's state live as long as the
+  // process.
+  void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!handle) throw Error(file.string() + ": cannot load the GDAL module (" + dlerror() + ")");
+  using Entry = const GdalModuleFunctions* (*)();
+  auto entry = reinterpret_cast<Entry>(dlsym(handle, "sapmvs_gdal_module"));
+  const GdalModuleFunctions* table = entry ? entry() : nullptr;
+  if (!table || table->version != kGdalModuleVersion ||
+      table->size != sizeof(GdalModuleFunctions)) {
+    throw Error(file.string() +
+                ": not this build's GDAL module (expected the libsapmvs_gdal.so built with this "
+                "sapmvs; rebuild or reinstall)");
+  }
+  return table;
 }
 
 std::atomic<bool> loaded{false};
@@ -82,10 +84,15 @@ int CheckCrsMain(const char* crs) {
   }
 }
 
-void CheckCrs(const std::string& crs) {
+void CheckGeoOutputs(const std::string& crs, const std::string& source) {
+  FindModule();  // the DSM rasters need it
   if (crs.empty()) return;
   if (loaded) {
-    CrsToWkt(crs);
+    try {
+      CrsToWkt(crs);
+    } catch (const Error& e) {
+      throw Error(source + ": " + e.what());
+    }
     return;
   }
   // A child (posix_spawn: safe with this process's threads, and it leaves
@@ -122,9 +129,10 @@ void CheckCrs(const std::string& crs) {
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   while (!said.empty() && (said.back() == '\n' || said.back() == '\r')) said.pop_back();
   if (const size_t line = said.rfind('\n'); line != std::string::npos) said = said.substr(line + 1);
-  throw Error(said.empty()
-                  ? "CRS '" + crs + "': the check failed (status " + std::to_string(status) + ")"
-                  : said);
+  throw Error(source + ": " +
+              (said.empty()
+                   ? "CRS '" + crs + "': the check failed (status " + std::to_string(status) + ")"
+                   : said));
 }
 
 cv::Mat DecodeImageWithGdal(const fs::path& path) { return Gdal().decode_image(path); }

@@ -157,7 +157,13 @@ std::string CrsToWkt(const std::string& crs) {
   return out;
 }
 
-void CheckCrs(const std::string& crs) { CrsToWkt(crs); }
+void CheckGeoOutputs(const std::string& crs, const std::string& source) {
+  try {
+    CrsToWkt(crs);
+  } catch (const Error& e) {
+    throw Error(source + ": " + e.what());
+  }
+}
 
 CrsIdentity IdentifyCrs(const std::string& crs) {
   QuietGdalErrors quiet;

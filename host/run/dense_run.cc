@@ -129,11 +129,8 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   };
 
   const Block block = ReadBlock(options.block, options.read);
-  try {
-    CheckCrs(block.crs);  // what cloud.las and dsm.tif will need, after all the matching
-  } catch (const Error& e) {
-    throw Error(block.source.string() + ": " + e.what());
-  }
+  // What cloud.las and the DSM rasters will need, after the matching.
+  CheckGeoOutputs(block.crs, block.source.string());
   report.images = static_cast<int>(block.images.size());
   const BlockGeometry geometry = EstimateBlockGeometry(block);
   // Without a GSD the merge radius would be 0, found only after matching.

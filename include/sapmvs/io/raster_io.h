@@ -60,11 +60,14 @@ GeoRaster ReadGeoRaster(const std::filesystem::path& path);
 // Converts a CRS given as WKT, "EPSG:n" or a PROJ string (no network look-up)
 // to OGR's default WKT; "" stays "". Throws sapmvs::Error naming the text.
 std::string CrsToWkt(const std::string& crs);
-// Throws as CrsToWkt when `crs` would fail it, so that a run refuses a bad
-// CRS before its matching. The binary checks in a child process
+// Throws when the outputs that need GDAL (the CRS of cloud.las, the DSM
+// rasters) could not be written: as CrsToWkt when it would refuse `crs`,
+// after `source: ` (the file that gave it), and in the binary when its GDAL
+// module is missing. A run calls it before its
+// matching. The binary checks the CRS in a child process
 // (cli/gdal_module.cc): a run whose images need no GDAL loads it only for
 // its outputs, after the matching's peak of memory.
-void CheckCrs(const std::string& crs);
+void CheckGeoOutputs(const std::string& crs, const std::string& source);
 
 // How a report names a CRS: its EPSG code (0 when it has none that PROJ can
 // find without the network) and its name ("WGS 84 / UTM zone 32N").
