@@ -151,13 +151,18 @@ TEST_F(ImageCodecTest, JpegAndPngDecodeAsGdalDecodesThem) {
 }
 
 TEST_F(ImageCodecTest, CorruptJpegOrPngNamesTheFileAndTheDecoder) {
-  for (const std::string name : {"bad.jpg", "bad.png"}) {
+  // The magic bytes survive, what follows them does not: the JPEG's tables,
+  // the PNG's header, or the middle of the PNG's pixel data (its checksum
+  // fails while the rows are read).
+  const std::vector<std::pair<std::string, int>> cases = {
+      {"bad.jpg", 20}, {"bad.png", 16}, {"bad_data.png", 1500}};
+  for (const auto& [name, at] : cases) {
     SCOPED_TRACE(name);
     const fs::path file = dir_ / name;
     ASSERT_TRUE(cv::imwrite(file.string(), RandomImage(CV_8UC3, 14)));
-    // The header survives, the first bytes after it do not.
+    ASSERT_GT(fs::file_size(file), static_cast<uintmax_t>(at + 64));
     std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
-    f.seekp(name == "bad.jpg" ? 20 : 16);
+    f.seekp(at);
     const std::string junk(64, '\x5a');
     f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
     f.close();

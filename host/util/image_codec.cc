@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "sapmvs/util/error.h"
 #include "util/gdal_image_files.h"
@@ -114,10 +115,12 @@ void OnPngError(png_structp png, png_const_charp message) {
 
 void IgnorePngWarning(png_structp /*png*/, png_const_charp /*message*/) {}
 
-// As DecodeJpeg. The transformations give what OpenCV's imread gave: 16-bit
+// As DecodeJpeg; `rows` is the caller's, so that a longjmp passes no
+// destructor. The transformations give what OpenCV's imread gave: 16-bit
 // samples keep their high byte, a palette and low bit depths are expanded,
 // grey is repeated, alpha dropped, no gamma applied.
-Decoded DecodePng(FILE* f, cv::Mat* pixels, cv::Size* size, std::string* error) {
+Decoded DecodePng(FILE* f, cv::Mat* pixels, cv::Size* size, std::string* error,
+                  std::vector<png_bytep>* rows) {
   PngError err{};
   png_structp png =
       png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, OnPngError, IgnorePngWarning);
@@ -151,9 +154,9 @@ Decoded DecodePng(FILE* f, cv::Mat* pixels, cv::Size* size, std::string* error) 
   png_set_interlace_handling(png);
   png_read_update_info(png, info);
   pixels->create(size->height, size->width, CV_8UC3);
-  std::vector<png_bytep> rows(static_cast<size_t>(size->height));
-  for (int r = 0; r < size->height; ++r) rows[static_cast<size_t>(r)] = pixels->ptr<png_byte>(r);
-  png_read_image(png, rows.data());
+  rows->resize(static_cast<size_t>(size->height));
+  for (int r = 0; r < size->height; ++r) (*rows)[static_cast<size_t>(r)] = pixels->ptr<png_byte>(r);
+  png_read_image(png, rows->data());
   png_read_end(png, nullptr);
   png_destroy_read_struct(&png, &info, nullptr);
   return Decoded::kDone;
@@ -165,8 +168,9 @@ bool DecodeHere(const std::filesystem::path& path, cv::Mat* pixels, cv::Size* si
   if (format == Format::kOther) return false;
   File file(path);
   std::string error;
+  std::vector<png_bytep> rows;
   const Decoded d = format == Format::kJpeg ? DecodeJpeg(file.f, pixels, size, &error)
-                                            : DecodePng(file.f, pixels, size, &error);
+                                            : DecodePng(file.f, pixels, size, &error, &rows);
   if (d == Decoded::kFailed) {
     throw Error(path.string() + ": cannot decode image (" +
                 (format == Format::kJpeg ? "libjpeg: " : "libpng: ") + error + ")");
