@@ -16,6 +16,7 @@
 #include "device/make_patch_kernels.h"
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/block_reader.h"
+#include "sapmvs/io/raster_io.h"
 #include "sapmvs/plan/grouping.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
@@ -65,8 +66,8 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
     } catch (const NoDeviceError&) {
     }
     ReleaseFreeMemory();
-    const GroupingPlan plan =
-        PlanGroups(block, args->grouping, args->matcher, &geometry, CurrentRssBytes());
+    const GroupingPlan plan = PlanGroups(block, args->grouping, args->matcher, &geometry,
+                                         CurrentRssBytes() + GdalBytesToLoad());
     PrintPlan(block, plan, std::cout);
     if (!args->json.empty()) {
       WriteTextAtomically(args->json, PlanToJson(block, plan).dump(2) + "\n");

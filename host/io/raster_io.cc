@@ -165,6 +165,8 @@ void CheckGeoOutputs(const std::string& crs, const std::string& source) {
   }
 }
 
+double GdalBytesToLoad() { return 0; }
+
 CrsIdentity IdentifyCrs(const std::string& crs) {
   QuietGdalErrors quiet;
   OGRSpatialReference srs;

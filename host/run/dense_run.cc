@@ -152,8 +152,9 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   // handed back: every group's estimate adds it (rank 0's under mpirun, so
   // that the ranks' plans agree).
   ReleaseFreeMemory();
-  const GroupingPlan plan = PlanGroups(block, options.grouping, options.matcher, &geometry,
-                                       dispatch.PlanProcessBytes(CurrentRssBytes()));
+  const GroupingPlan plan =
+      PlanGroups(block, options.grouping, options.matcher, &geometry,
+                 dispatch.PlanProcessBytes(CurrentRssBytes() + GdalBytesToLoad()));
   report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
   for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   end_stage("plan");

@@ -68,6 +68,12 @@ std::string CrsToWkt(const std::string& crs);
 // (cli/gdal_module.cc): a run whose images need no GDAL loads it only for
 // its outputs, after the matching's peak of memory.
 void CheckGeoOutputs(const std::string& crs, const std::string& source);
+// The resident memory that loading GDAL to write the outputs will add: 0
+// where GDAL is linked in or already loaded, and in the binary, before it
+// loads its GDAL module, what GDAL and its libraries held at the end of a
+// run on `small` (37 MiB), rounded up. Plans count it as part of the
+// process, so that a memory budget also bounds the outputs' peak.
+double GdalBytesToLoad();
 
 // How a report names a CRS: its EPSG code (0 when it has none that PROJ can
 // find without the network) and its name ("WGS 84 / UTM zone 32N").
