@@ -130,8 +130,8 @@ TEST_F(PlyIoTest, FilteredReadKeepsTheAcceptedPointsInOrder) {
 
   const fs::path ascii = dir_ / "hand.ply";
   WritePlyText(ascii,
-            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-            "property float z\nend_header\n-1 0 0\n6e5 0 0\n-3 0 0\n7e5 0 0\n");
+               "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+               "property float z\nend_header\n-1 0 0\n6e5 0 0\n-3 0 0\n7e5 0 0\n");
   const PointCloud a = ReadPly(ascii, west);
   ASSERT_EQ(a.points.size(), 2u);
   EXPECT_EQ(a.points[0].position.x(), -1);
@@ -206,31 +206,31 @@ TEST_F(PlyIoTest, OnlyCoordinatesWhenNoOptionalField) {
 TEST_F(PlyIoTest, ReadsAsciiBuiltByHand) {
   const fs::path path = dir_ / "hand.ply";
   WritePlyText(path,
-            "ply\r\n"
-            "format ascii 1.0\r\n"
-            "comment made by hand\r\n"
-            "comment crs EPSG:32632\r\n"
-            "obj_info anything\r\n"
-            "element vertex 3\r\n"
-            "property float x\r\n"
-            "property float y\r\n"
-            "property double z\r\n"
-            "property int extra\r\n"
-            "property list uchar int indices\r\n"
-            "property uchar red\r\n"
-            "property uchar green\r\n"
-            "property uchar blue\r\n"
-            "property float nx\r\n"
-            "property float ny\r\n"
-            "property float nz\r\n"
-            "element face 1\r\n"
-            "property list uchar int vertex_indices\r\n"
-            "end_header\r\n"
-            "1.5 2 300.25 -7 2 10 11 255 0 128 0 0 1\r\n"
-            "-1 -2.5e1 0 3 0 1 2 3 0.6 0 0.8\r\n"
-            "\r\n"
-            "4 5 6 0 1 9 7 8 9 0 1 0\r\n"
-            "3 0 1 2\r\n");
+               "ply\r\n"
+               "format ascii 1.0\r\n"
+               "comment made by hand\r\n"
+               "comment crs EPSG:32632\r\n"
+               "obj_info anything\r\n"
+               "element vertex 3\r\n"
+               "property float x\r\n"
+               "property float y\r\n"
+               "property double z\r\n"
+               "property int extra\r\n"
+               "property list uchar int indices\r\n"
+               "property uchar red\r\n"
+               "property uchar green\r\n"
+               "property uchar blue\r\n"
+               "property float nx\r\n"
+               "property float ny\r\n"
+               "property float nz\r\n"
+               "element face 1\r\n"
+               "property list uchar int vertex_indices\r\n"
+               "end_header\r\n"
+               "1.5 2 300.25 -7 2 10 11 255 0 128 0 0 1\r\n"
+               "-1 -2.5e1 0 3 0 1 2 3 0.6 0 0.8\r\n"
+               "\r\n"
+               "4 5 6 0 1 9 7 8 9 0 1 0\r\n"
+               "3 0 1 2\r\n");
   const PointCloud c = ReadPly(path);
   ASSERT_EQ(c.points.size(), 3u);
   EXPECT_EQ(c.crs, "EPSG:32632");
@@ -303,9 +303,9 @@ TEST_F(PlyIoTest, ReadsBigEndianBuiltByHand) {
 TEST_F(PlyIoTest, ScalarPrefixedScoreAndViewsAreRead) {
   const fs::path path = dir_ / "cc.ply";
   WritePlyText(path,
-            "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
-            "property double z\nproperty float scalar_score\nproperty float scalar_views\n"
-            "end_header\n1 2 3 0.5 4\n4 5 6 -0.25 7\n");
+               "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
+               "property double z\nproperty float scalar_score\nproperty float scalar_views\n"
+               "end_header\n1 2 3 0.5 4\n4 5 6 -0.25 7\n");
   const PointCloud c = ReadPly(path);
   ASSERT_EQ(c.points.size(), 2u);
   EXPECT_TRUE(c.has_scores && c.has_views);

@@ -3,11 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 
-#include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
-#include "util/input_file.h"
 
 namespace sapmvs {
 

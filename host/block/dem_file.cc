@@ -9,7 +9,6 @@
 #include <memory>
 
 #include "sapmvs/util/error.h"
-#include "sapmvs/util/number_text.h"
 #include "util/input_file.h"
 
 namespace sapmvs {
