@@ -4,7 +4,10 @@
 # and PoCL) and the fixtures it builds serve the whole suite, and one per
 # test for those whose names match E2E (each its own process and timeout).
 # Labels: DEVICE (host or opencl) and fast or e2e, and mpi for the e2e tests
-# that match MPI.
+# that match MPI. The runs the tests make keep no program binaries
+# (SAPMVS_PROGRAM_CACHE=off): they would fill the user's cache folder, and
+# PoCL compiles a program once more to hand out its binary (0.5 s each), for
+# the tests' many variants; the cache's own tests give it folders.
 execute_process(COMMAND "${EXE}" --gtest_list_tests OUTPUT_VARIABLE listing
                 RESULT_VARIABLE rc TIMEOUT 60)
 if(NOT rc EQUAL 0)
@@ -32,7 +35,8 @@ set(out "")
 macro(add name filter labels)
   string(APPEND out "add_test([==[${name}]==] [==[${EXE}]==] [==[--gtest_filter=${filter}]==])\n"
          "set_tests_properties([==[${name}]==] PROPERTIES WORKING_DIRECTORY [==[${WORKDIR}]==]"
-         " TIMEOUT 600 LABELS [==[${labels}]==])\n")
+         " TIMEOUT 600 LABELS [==[${labels}]==]"
+         " ENVIRONMENT [==[SAPMVS_PROGRAM_CACHE=off]==])\n")
 endmacro()
 foreach(suite IN LISTS suites)
   if(fast_${suite})

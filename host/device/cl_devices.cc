@@ -83,6 +83,7 @@ DeviceInfo QueryDevice(cl_platform_id platform, int platform_index, cl_device_id
   info.host_unified_memory = DeviceValue<cl_bool>(id, CL_DEVICE_HOST_UNIFIED_MEMORY) != CL_FALSE;
   info.version = DeviceString(id, CL_DEVICE_VERSION);
   info.opencl_c_version = DeviceString(id, CL_DEVICE_OPENCL_C_VERSION);
+  info.driver_version = DeviceString(id, CL_DRIVER_VERSION);
   return info;
 }
 

@@ -41,6 +41,7 @@ struct DeviceInfo {
   bool host_unified_memory = false;
   std::string version;           // CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ...".
   std::string opencl_c_version;  // CL_DEVICE_OPENCL_C_VERSION, e.g. "OpenCL C 1.2 PoCL".
+  std::string driver_version;    // CL_DRIVER_VERSION, e.g. "3.1+debian" or "550.54.15".
   cl_platform_id platform_id = nullptr;
   cl_device_id id = nullptr;
 
@@ -71,6 +72,10 @@ struct DeviceOptions {
   // Create the queue with CL_QUEUE_PROFILING_ENABLE so ClEvent::DeviceTimeNs()
   // works. Costs a little per launch on some drivers.
   bool profile = false;
+  // Where built programs are kept between runs (program_binary_cache.h):
+  // "" = SAPMVS_PROGRAM_CACHE from the environment if set, else the user's
+  // cache folder (~/.cache/sapmvs/programs); "off" = nowhere; else a folder.
+  std::string program_cache;
 
   // False for a spec that can never match: a negative index or control
   // characters.

@@ -191,7 +191,7 @@ uint64_t ClKernel::LocalMemBytes(cl_device_id device) const {
 
 ClProgram::ClProgram(cl_context context, cl_device_id device, std::string name,
                      std::string_view source, std::string options)
-    : name_(std::move(name)), options_(std::move(options)) {
+    : ClProgram(std::move(name), std::move(options)) {
   const char* text = source.data();
   const size_t length = source.size();
   cl_int status = CL_SUCCESS;
@@ -200,6 +200,45 @@ ClProgram::ClProgram(cl_context context, cl_device_id device, std::string name,
   if (status != CL_SUCCESS) {
     throw ClError(status, "clCreateProgramWithSource", __FILE__, __LINE__, "program " + name_);
   }
+  Build(device);
+}
+
+ClProgram ClProgram::FromBinary(cl_context context, cl_device_id device, std::string name,
+                                const std::vector<unsigned char>& binary, std::string options) {
+  ClProgram program(std::move(name), std::move(options));
+  const unsigned char* bytes = binary.data();
+  const size_t length = binary.size();
+  cl_int binary_status = CL_SUCCESS;
+  cl_int status = CL_SUCCESS;
+  program.program_ = internal::ClHandle<cl_program>(
+      clCreateProgramWithBinary(context, 1, &device, &length, &bytes, &binary_status, &status));
+  if (status == CL_SUCCESS) status = binary_status;
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateProgramWithBinary", __FILE__, __LINE__,
+                  "program " + program.name_);
+  }
+  program.Build(device);
+  program.from_binary_ = true;
+  return program;
+}
+
+std::vector<unsigned char> ClProgram::Binary() const {
+  size_t size = 0;
+  if (clGetProgramInfo(program_.get(), CL_PROGRAM_BINARY_SIZES, sizeof(size), &size, nullptr) !=
+          CL_SUCCESS ||
+      size == 0) {
+    return {};
+  }
+  std::vector<unsigned char> binary(size);
+  unsigned char* bytes = binary.data();
+  if (clGetProgramInfo(program_.get(), CL_PROGRAM_BINARIES, sizeof(bytes), &bytes, nullptr) !=
+      CL_SUCCESS) {
+    return {};
+  }
+  return binary;
+}
+
+void ClProgram::Build(cl_device_id device) {
   const cl_int build_status =
       clBuildProgram(program_.get(), 1, &device, options_.c_str(), nullptr, nullptr);
   size_t log_size = 0;
@@ -259,10 +298,11 @@ std::string BuildOptions::Render() const {
 // ---------------------------------------------------------------------------
 
 ClContext::ClContext(const DeviceOptions& options)
-    : ClContext(SelectedDevice(options), options.profile) {}
+    : ClContext(SelectedDevice(options), options.profile,
+                ProgramBinaryCache(ProgramCacheFolder(options.program_cache))) {}
 
-ClContext::ClContext(const DeviceInfo& device, bool profile)
-    : device_(device), profiling_(profile) {
+ClContext::ClContext(const DeviceInfo& device, bool profile, ProgramBinaryCache binaries)
+    : device_(device), profiling_(profile), binaries_(std::move(binaries)) {
   if (device.id == nullptr || device.platform_id == nullptr) {
     throw std::invalid_argument("ClContext needs a DeviceInfo from ListDevices()");
   }
@@ -325,6 +365,7 @@ ClContext& ClContext::operator=(ClContext&& other) noexcept {
     Release();
     device_ = std::move(other.device_);
     profiling_ = other.profiling_;
+    binaries_ = std::move(other.binaries_);
     context_ = std::move(other.context_);
     queues_ = std::move(other.queues_);
     leased_ = other.leased_;
@@ -386,11 +427,28 @@ const ClProgram& ClContext::CachedProgram(std::string_view name, const BuildOpti
   }
   CacheEntry entry;
   entry.source_hash = given ? source_hash : std::hash<std::string_view>{}(*source);
-  entry.program = std::make_unique<ClProgram>(context_.get(), device_.id, std::get<1>(key), *source,
-                                              std::get<2>(key));
+  entry.program = BuildOrLoad(std::get<1>(key), *source, std::get<2>(key));
   std::lock_guard<std::mutex> lock(*programs_mutex_);
   if (const ClProgram* program = cached()) return *program;
   return *programs_.emplace(std::move(key), std::move(entry)).first->second.program;
+}
+
+std::unique_ptr<ClProgram> ClContext::BuildOrLoad(const std::string& name, std::string_view source,
+                                                  const std::string& options) const {
+  if (!binaries_.enabled()) {
+    return std::make_unique<ClProgram>(context_.get(), device_.id, name, source, options);
+  }
+  const std::string key = ProgramCacheKey(device_, options, source);
+  if (const std::optional<std::vector<unsigned char>> binary = binaries_.Load(key)) {
+    try {
+      return std::make_unique<ClProgram>(
+          ClProgram::FromBinary(context_.get(), device_.id, name, *binary, options));
+    } catch (const std::exception&) {  // refused by the driver: built below, stored anew
+    }
+  }
+  auto program = std::make_unique<ClProgram>(context_.get(), device_.id, name, source, options);
+  binaries_.Store(key, program->Binary());
+  return program;
 }
 
 ClEvent ClContext::Enqueue(const ClKernel& kernel, const NDRange& global, const NDRange& local) {

@@ -30,6 +30,7 @@
 
 #include "device/cl_devices.h"
 #include "device/cl_error.h"
+#include "device/program_binary_cache.h"
 
 namespace sapmvs {
 
@@ -262,19 +263,34 @@ class ClProgram {
   // Builds `source` for `device`; throws ProgramBuildError with the full log.
   ClProgram(cl_context context, cl_device_id device, std::string name, std::string_view source,
             std::string options);
+  // Loads `binary`, which Binary() gave for the same device, driver, options
+  // and source. Throws ClError or ProgramBuildError when the driver refuses
+  // it (another driver's, damaged).
+  static ClProgram FromBinary(cl_context context, cl_device_id device, std::string name,
+                              const std::vector<unsigned char>& binary, std::string options);
 
   cl_program get() const { return program_.get(); }
   const std::string& name() const { return name_; }
   const std::string& options() const { return options_; }
   const std::string& build_log() const { return build_log_; }  // Warnings, if any.
+  bool from_binary() const { return from_binary_; }
+  // The device's binary of the program (CL_PROGRAM_BINARIES); empty when the
+  // driver gives none.
+  std::vector<unsigned char> Binary() const;
 
   ClKernel Kernel(const std::string& kernel_name) const { return ClKernel(*this, kernel_name); }
 
  private:
+  ClProgram(std::string name, std::string options)
+      : name_(std::move(name)), options_(std::move(options)) {}
+  // clBuildProgram, keeping the log; throws ProgramBuildError.
+  void Build(cl_device_id device);
+
   internal::ClHandle<cl_program> program_;
   std::string name_;
   std::string options_;
   std::string build_log_;
+  bool from_binary_ = false;
 };
 
 // `-D NAME=VALUE` defines for a program build, rendered sorted by name so
@@ -331,7 +347,9 @@ class ClContext {
   };
   // Selects a device as described in DeviceOptions. Throws NoDeviceError.
   explicit ClContext(const DeviceOptions& options = DeviceOptions());
-  ClContext(const DeviceInfo& device, bool profile);
+  // `binaries`: where built programs are kept between processes (none by
+  // default).
+  ClContext(const DeviceInfo& device, bool profile, ProgramBinaryCache binaries = {});
   // Waits for the queue (Finish) before releasing the programs, the queue and
   // the context, in that order. A command still in flight at release can
   // leave a driver thread working (PoCL compiles a kernel's work-group
@@ -352,7 +370,8 @@ class ClContext {
   bool profiling() const { return profiling_; }
 
   // The program built from kernels/<kernel_file> (see KernelSource) with
-  // `defines`; built on first use, then cached by (device, name, options).
+  // `defines`; built on first use (or loaded from the binary cache), then
+  // cached by (device, name, options).
   // Thread-safe; several threads build different programs at once.
   const ClProgram& Program(std::string_view kernel_file, const BuildOptions& defines = {});
   // Same, from a source string (tests, generated code). `name` must identify
@@ -393,11 +412,16 @@ class ClContext {
   // `source` empty: load kernels/<name> on a cache miss.
   const ClProgram& CachedProgram(std::string_view name, const BuildOptions& defines,
                                  std::optional<std::string_view> source);
+  // A program from `source`: the binary cache's when it has a usable one,
+  // else built from source, and then stored there.
+  std::unique_ptr<ClProgram> BuildOrLoad(const std::string& name, std::string_view source,
+                                         const std::string& options) const;
   // Finish, then release in order; leaves the object empty. Never throws.
   void Release() noexcept;
 
   DeviceInfo device_;
   bool profiling_ = false;
+  ProgramBinaryCache binaries_;
   internal::ClHandle<cl_context> context_;
   // The main queue at 0, the lanes after it.
   std::array<internal::ClHandle<cl_command_queue>, 1 + kLanes> queues_;
