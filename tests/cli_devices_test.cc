@@ -34,6 +34,19 @@ TEST(CliDevices, ChoosesByIndexFlagOrEnvironment) {
   EXPECT_NE(env.out.find("chosen by SAPMVS_DEVICE \"0\""), std::string::npos) << env.out;
 }
 
+TEST(CliDevices, SaysWhereBuiltKernelsAreKept) {
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const auto set = RunCli("devices", "SAPMVS_PROGRAM_CACHE=/some/folder");
+  ASSERT_EQ(set.exit_code, 0) << set.err;
+  EXPECT_NE(set.out.find("built kernels: kept in /some/folder"), std::string::npos) << set.out;
+  const auto home = RunCli("devices", "env -u SAPMVS_PROGRAM_CACHE -u XDG_CACHE_HOME HOME=/h");
+  ASSERT_EQ(home.exit_code, 0) << home.err;
+  EXPECT_NE(home.out.find("kept in /h/.cache/sapmvs/programs"), std::string::npos) << home.out;
+  const auto off = RunCli("devices", "SAPMVS_PROGRAM_CACHE=off");
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  EXPECT_NE(off.out.find("built kernels: not kept"), std::string::npos) << off.out;
+}
+
 TEST(CliDevices, UnmatchedDeviceIsOneLineAndExitCode2) {
   SAPMVS_REQUIRE_OPENCL_DEVICE();
   const auto r = RunCli("devices --device no-such-device-anywhere");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cl_test_fixture.h"
+#include "cli_test_util.h"
 #include "device/cl_runtime.h"
 #include "test_util.h"
 
@@ -229,6 +230,35 @@ TEST_F(ProgramBinaryCacheClTest, AnUnwritableFolderLeavesBuildsAsWithout) {
       fresh.ProgramFromSource("scale_test", kScaleSource, {{"SCALE", "1"}, {"OFFSET", "0"}});
   EXPECT_FALSE(program.from_binary());
   EXPECT_EQ(Scaled(fresh, program)[36], 36);
+}
+
+// A run keeps its kernels where SAPMVS_PROGRAM_CACHE says, the next run
+// loads them instead of building them (the entries stay as written), and
+// the kernels loaded match as the built ones did: the same cloud.
+TEST_F(ProgramBinaryCacheTest, ARunKeepsItsKernelsAndTheNextLoadsThemForTheSameCloud) {
+  SAPMVS_REQUIRE_OPENCL_DEVICE();
+  const fs::path block = test::Simulated("tiny", 1) / "block.yaml";
+  const fs::path cache = dir_ / "programs";
+  const std::string env = "SAPMVS_PROGRAM_CACHE=" + cache.string();
+  const auto first =
+      test::RunCli("run " + block.string() + " --out " + (dir_ / "a").string() + " -q", env);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const std::vector<fs::path> kept = CacheFiles(cache);
+  ASSERT_FALSE(kept.empty());
+  std::vector<fs::file_time_type> written;
+  for (const fs::path& f : kept) written.push_back(fs::last_write_time(f));
+
+  const auto second =
+      test::RunCli("run " + block.string() + " --out " + (dir_ / "b").string() + " -q", env);
+  ASSERT_EQ(second.exit_code, 0) << second.err;
+  ASSERT_EQ(CacheFiles(cache), kept);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_EQ(fs::last_write_time(kept[i]), written[i]) << kept[i] << " was built again";
+  }
+  const std::string cloud = test::Slurp(dir_ / "a" / "cloud.ply");
+  ASSERT_FALSE(cloud.empty());
+  EXPECT_TRUE(cloud == test::Slurp(dir_ / "b" / "cloud.ply"))
+      << "the loaded kernels' cloud differs";
 }
 
 }  // namespace

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "device/cl_devices.h"
+#include "device/program_binary_cache.h"
 #include "match/patch_kernels.h"
 #include "sapmvs/util/error.h"
 
@@ -69,6 +71,15 @@ void PrintDeviceTable(const std::string& spec_text, std::ostream& out) {
            "choose another with --device INDEX|NAME|reference or SAPMVS_DEVICE\n";
   } else {
     out << "* = device chosen by " << spec.source << " \"" << spec.value << "\"\n";
+  }
+  if (reference) return;
+  // Where a run keeps its built kernels, so that a user can find and clear it.
+  const std::filesystem::path cache = ProgramCacheFolder(options.program_cache);
+  if (cache.empty()) {
+    out << "built kernels: not kept between runs (SAPMVS_PROGRAM_CACHE=off, or no cache folder)\n";
+  } else {
+    out << "built kernels: kept in " << cache.string() << " (SAPMVS_PROGRAM_CACHE names another, "
+        << "or off)\n";
   }
 }
 
