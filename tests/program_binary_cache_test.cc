@@ -73,6 +73,12 @@ TEST_F(ProgramBinaryCacheTest, LoadsOnlyTheWholeEntryOfItsKey) {
   header[2] = 'X';
   EXPECT_FALSE(load_after(header));
   EXPECT_FALSE(load_after(""));
+  // A header that announces more than the file holds is not believed.
+  const size_t binary_line = whole.find("binary ");
+  ASSERT_NE(binary_line, std::string::npos);
+  std::string huge = whole;
+  huge.replace(binary_line, 7, "binary 99999999999");
+  EXPECT_FALSE(load_after(huge));
   EXPECT_TRUE(load_after(whole));  // and the checks pass the original
   // A new store replaces the entry.
   ASSERT_TRUE(cache.Store(key, AsBinary("other")));

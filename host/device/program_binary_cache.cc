@@ -1,11 +1,11 @@
 #include "device/program_binary_cache.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <iterator>
 #include <system_error>
 
 #include "sapmvs/util/atomic_file.h"
@@ -15,6 +15,8 @@ namespace sapmvs {
 namespace {
 
 constexpr std::string_view kMagic = "sapmvs program binary 1\n";
+// The magic line and the two length lines fit in this with room to spare.
+constexpr uintmax_t kMaxHeaderBytes = 256;
 
 // FNV-1a: stable across builds and machines, unlike std::hash, and enough
 // to name an entry and to catch a damaged one (the key is compared whole).
@@ -92,27 +94,37 @@ std::filesystem::path ProgramBinaryCache::EntryPath(std::string_view key) const 
 
 std::optional<std::vector<unsigned char>> ProgramBinaryCache::Load(std::string_view key) const {
   if (!enabled()) return std::nullopt;
-  std::ifstream in(EntryPath(key), std::ios::binary);
+  const std::filesystem::path path = EntryPath(key);
+  std::error_code error;
+  const uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) return std::nullopt;
+  std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
-  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad() || file.compare(0, kMagic.size(), kMagic) != 0) return std::nullopt;
+  // The header alone first: a file whose size is not the one it announces
+  // (cut short, grown, another file) is never read whole.
+  std::string head(static_cast<size_t>(std::min<uintmax_t>(size, kMaxHeaderBytes)), '\0');
+  if (!in.read(head.data(), static_cast<std::streamsize>(head.size()))) return std::nullopt;
+  if (head.compare(0, kMagic.size(), kMagic) != 0) return std::nullopt;
   size_t at = kMagic.size();
   size_t key_length = 0;
   size_t binary_length = 0;
   std::string key_sum;
   std::string binary_sum;
-  if (!ReadField(file, &at, "key", &key_length, &key_sum) ||
-      !ReadField(file, &at, "binary", &binary_length, &binary_sum)) {
+  if (!ReadField(head, &at, "key", &key_length, &key_sum) ||
+      !ReadField(head, &at, "binary", &binary_length, &binary_sum)) {
     return std::nullopt;
   }
-  if (key_length != key.size() || binary_length == 0 || at > file.size() ||
-      file.size() - at != key_length + binary_length) {
+  if (key_length != key.size() || binary_length == 0 || binary_length > size ||
+      size != at + key_length + binary_length || key_sum != Hex(Fnv1a(key.data(), key.size()))) {
     return std::nullopt;
   }
-  if (key_sum != Hex(Fnv1a(key.data(), key.size())) || file.compare(at, key_length, key) != 0) {
+  std::string body(key_length + binary_length, '\0');
+  if (!in.seekg(static_cast<std::streamoff>(at)) ||
+      !in.read(body.data(), static_cast<std::streamsize>(body.size())) ||
+      body.compare(0, key_length, key) != 0) {
     return std::nullopt;
   }
-  const char* binary = file.data() + at + key_length;
+  const char* binary = body.data() + key_length;
   if (binary_sum != Hex(Fnv1a(binary, binary_length))) return std::nullopt;
   return std::vector<unsigned char>(binary, binary + binary_length);
 }
