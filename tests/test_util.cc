@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -112,6 +113,21 @@ std::filesystem::path HerzJesu() { return SharedDir() / "datasets/strecha_herzje
 std::string Slurp(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void WriteFileBytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << bytes;
+}
+
+std::vector<std::filesystem::path> FolderEntries(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> entries;
+  if (!std::filesystem::exists(dir)) return entries;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    entries.push_back(entry.path());
+  }
+  std::sort(entries.begin(), entries.end());
+  return entries;
 }
 
 std::filesystem::path SharedDir() {

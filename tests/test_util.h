@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,8 +26,36 @@ std::filesystem::path SharedDir();
 std::filesystem::path HerzJesu();
 // The bytes of `path`; "" when it cannot be read.
 std::string Slurp(const std::filesystem::path& path);
+// Replaces `path` with `bytes` (a test's own files; no atomic write).
+void WriteFileBytes(const std::filesystem::path& path, const std::string& bytes);
+// The entries of `dir`, sorted; none when it does not exist.
+std::vector<std::filesystem::path> FolderEntries(const std::filesystem::path& dir);
 // A fresh, empty directory under the system temp dir, unique per test.
 std::filesystem::path ScratchDir();
+
+// Sets (or, with nullopt, unsets) an environment variable for one scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, std::optional<std::string> value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    Set(value);
+  }
+  ~ScopedEnv() { Set(old_); }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  void Set(const std::optional<std::string>& value) {
+    if (value) {
+      setenv(name_.c_str(), value->c_str(), 1);
+    } else {
+      unsetenv(name_.c_str());
+    }
+  }
+
+  std::string name_;
+  std::optional<std::string> old_;
+};
 
 // A folder that `make` fills once for every test process of this build and
 // that the tests then only read: ctest runs each test in its own process, so
