@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "sapmvs/util/error.h"
 
@@ -91,22 +92,15 @@ int CheckCrsMain(const char* crs) {
   }
 }
 
-void CheckGeoOutputs(const std::string& crs, const std::string& source) {
-  FindModule();  // the DSM rasters need it
-  if (crs.empty()) return;
-  if (loaded) {
-    try {
-      CrsToWkt(crs);
-    } catch (const Error& e) {
-      throw Error(source + ": " + e.what());
-    }
-    return;
-  }
+GeoOutputsCheck::GeoOutputsCheck(std::string crs, std::string source)
+    : crs_(std::move(crs)), source_(std::move(source)) {
+  FindModule();                        // the DSM rasters need it
+  if (crs_.empty() || loaded) return;  // Wait() checks in this process
   // A child (posix_spawn: safe with this process's threads, and it leaves
   // its memory alone) loads GDAL and checks; this process does not load it.
   int pipe_fds[2];
   if (pipe2(pipe_fds, O_CLOEXEC) != 0) {
-    throw Error("CRS '" + crs + "': cannot check it (pipe: " + std::strerror(errno) + ")");
+    throw Error("CRS '" + crs_ + "': cannot check it (pipe: " + std::strerror(errno) + ")");
   }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -114,31 +108,58 @@ void CheckGeoOutputs(const std::string& crs, const std::string& source) {
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   const std::string exe = "/proc/self/exe";
   char* const argv[] = {const_cast<char*>("sapmvs"), const_cast<char*>(kCheckCrsArgument),
-                        const_cast<char*>(crs.c_str()), nullptr};
+                        const_cast<char*>(crs_.c_str()), nullptr};
   pid_t pid = 0;
   const int spawned = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv, environ);
   posix_spawn_file_actions_destroy(&actions);
   close(pipe_fds[1]);
+  if (spawned != 0) {
+    close(pipe_fds[0]);
+    throw Error("CRS '" + crs_ + "': cannot check it (" + std::strerror(spawned) + ")");
+  }
+  child_ = pid;
+  child_stderr_ = pipe_fds[0];
+}
+
+GeoOutputsCheck::~GeoOutputsCheck() {
+  // Closing first ends a child still writing (EPIPE); then it is reaped.
+  if (child_stderr_ >= 0) close(child_stderr_);
+  int status = 0;
+  if (child_ > 0) {
+    while (waitpid(child_, &status, 0) < 0 && errno == EINTR) {
+    }
+  }
+}
+
+void GeoOutputsCheck::Wait() {
+  if (crs_.empty()) return;
+  if (child_ <= 0) {
+    try {
+      CrsToWkt(crs_);
+    } catch (const Error& e) {
+      throw Error(source_ + ": " + e.what());
+    }
+    return;
+  }
   std::string said;
   char buffer[4096];
-  for (ssize_t n; (n = read(pipe_fds[0], buffer, sizeof(buffer))) != 0;) {
+  for (ssize_t n; (n = read(child_stderr_, buffer, sizeof(buffer))) != 0;) {
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) break;
     said.append(buffer, static_cast<size_t>(n));
   }
-  close(pipe_fds[0]);
-  if (spawned != 0) {
-    throw Error("CRS '" + crs + "': cannot check it (" + std::strerror(spawned) + ")");
-  }
+  close(child_stderr_);
+  child_stderr_ = -1;
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  while (waitpid(child_, &status, 0) < 0 && errno == EINTR) {
   }
+  child_ = -1;
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
   while (!said.empty() && (said.back() == '\n' || said.back() == '\r')) said.pop_back();
   if (const size_t line = said.rfind('\n'); line != std::string::npos) said = said.substr(line + 1);
-  throw Error(source + ": " +
+  throw Error(source_ + ": " +
               (said.empty()
-                   ? "CRS '" + crs + "': the check failed (status " + std::to_string(status) + ")"
+                   ? "CRS '" + crs_ + "': the check failed (status " + std::to_string(status) + ")"
                    : said));
 }
 

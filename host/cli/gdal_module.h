@@ -50,7 +50,7 @@ struct GdalModuleFunctions {
 
 constexpr int kGdalModuleVersion = 1;
 
-// The argument that makes the binary a CRS checker (CheckGeoOutputs in
+// The argument that makes the binary a CRS checker (GeoOutputsCheck in
 // gdal_module.cc): `sapmvs --internal-check-crs CRS` loads the module, checks
 // CRS, prints what is wrong on stderr and exits 1, or exits 0.
 constexpr const char* kCheckCrsArgument = "--internal-check-crs";

@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <sstream>
+#include <utility>
 
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
@@ -157,11 +158,17 @@ std::string CrsToWkt(const std::string& crs) {
   return out;
 }
 
-void CheckGeoOutputs(const std::string& crs, const std::string& source) {
+// GDAL is linked in here (tests, tools): the check needs no process.
+GeoOutputsCheck::GeoOutputsCheck(std::string crs, std::string source)
+    : crs_(std::move(crs)), source_(std::move(source)) {}
+
+GeoOutputsCheck::~GeoOutputsCheck() = default;
+
+void GeoOutputsCheck::Wait() {
   try {
-    CrsToWkt(crs);
+    CrsToWkt(crs_);
   } catch (const Error& e) {
-    throw Error(source + ": " + e.what());
+    throw Error(source_ + ": " + e.what());
   }
 }
 

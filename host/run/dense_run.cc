@@ -129,10 +129,12 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   };
 
   const Block block = ReadBlock(options.block, options.read);
-  // What cloud.las and the DSM rasters will need, after the matching.
-  CheckGeoOutputs(block.crs, block.source.string());
+  // What cloud.las and the DSM rasters will need, after the matching:
+  // checked while the block's geometry is estimated.
+  GeoOutputsCheck geo_outputs(block.crs, block.source.string());
   report.images = static_cast<int>(block.images.size());
   const BlockGeometry geometry = EstimateBlockGeometry(block);
+  geo_outputs.Wait();
   // Without a GSD the merge radius would be 0, found only after matching.
   if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
     throw Error(reason);

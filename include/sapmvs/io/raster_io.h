@@ -60,14 +60,31 @@ GeoRaster ReadGeoRaster(const std::filesystem::path& path);
 // Converts a CRS given as WKT, "EPSG:n" or a PROJ string (no network look-up)
 // to OGR's default WKT; "" stays "". Throws sapmvs::Error naming the text.
 std::string CrsToWkt(const std::string& crs);
-// Throws when the outputs that need GDAL (the CRS of cloud.las, the DSM
-// rasters) could not be written: as CrsToWkt when it would refuse `crs`,
-// after `source: ` (the file that gave it), and in the binary when its GDAL
-// module is missing. A run calls it before its
-// matching. The binary checks the CRS in a child process
-// (cli/gdal_module.cc): a run whose images need no GDAL loads it only for
-// its outputs, after the matching's peak of memory.
-void CheckGeoOutputs(const std::string& crs, const std::string& source);
+// Whether the outputs that need GDAL (the CRS of cloud.las, the DSM
+// rasters) can be written, checked while the caller goes on: a run starts
+// it before the block's geometry and waits for it before its plan. The
+// binary checks the CRS in a child process (cli/gdal_module.cc; 0.08 s, a
+// process start and GDAL's), so that a run whose images need no GDAL loads
+// it only for its outputs, after the matching's peak of memory.
+class GeoOutputsCheck {
+ public:
+  // Throws at once in the binary when its GDAL module is missing.
+  GeoOutputsCheck(std::string crs, std::string source);
+  // Without Wait(), waits for the child and drops its answer.
+  ~GeoOutputsCheck();
+  GeoOutputsCheck(const GeoOutputsCheck&) = delete;
+  GeoOutputsCheck& operator=(const GeoOutputsCheck&) = delete;
+
+  // Throws as CrsToWkt when it would refuse the CRS, after `source: ` (the
+  // file that gave it).
+  void Wait();
+
+ private:
+  std::string crs_;
+  std::string source_;
+  int child_ = -1;         // the checking process, in the binary
+  int child_stderr_ = -1;  // the read end of its stderr
+};
 // The resident memory that loading GDAL to write the outputs will add: 0
 // where GDAL is linked in or already loaded, and in the binary, before it
 // loads its GDAL module, what GDAL and its libraries held at the end of a
