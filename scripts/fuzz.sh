@@ -7,7 +7,7 @@
 #   scripts/fuzz.sh [--runs N] [--max-time S] [--max-len BYTES] [--lanes L] [target...]
 #
 # Targets: block_yaml block_pmvs colmap_text colmap_binary block_strecha
-# block_opensfm ply las (all by default). The corpora grow in
+# block_opensfm ply las program_cache (all by default). The corpora grow in
 # build/fuzz/corpus/TARGET across runs; a finding is saved as
 # build/fuzz/artifacts/TARGET-crash-* (replay: build/fuzz/tests/fuzz/fuzz_TARGET FILE)
 # and the script exits 1. Not a CI step: 1 M runs of one target take 5 to 15
@@ -37,7 +37,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-all=(block_yaml block_pmvs colmap_text colmap_binary block_strecha block_opensfm ply las)
+all=(block_yaml block_pmvs colmap_text colmap_binary block_strecha block_opensfm ply las program_cache)
 [ ${#targets[@]} -gt 0 ] || targets=("${all[@]}")
 for t in "${targets[@]}"; do
   [[ " ${all[*]} " == *" $t "* ]] || { echo "fuzz.sh: unknown target '$t' (expected one of: ${all[*]})" >&2; exit 1; }

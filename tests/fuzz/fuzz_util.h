@@ -25,6 +25,10 @@ namespace sapmvs::fuzz {
 namespace fs = std::filesystem;
 
 inline constexpr std::string_view kSeparator = "\n--8<--\n";
+// The key of the program cache target's entries (its seeds are stored with
+// it by make_seeds).
+inline constexpr std::string_view kProgramCacheKey =
+    "platform: fuzz\ndevice: fuzz\ndriver: 1\noptions: -D A=1\nsource:\n__kernel void k() {}\n";
 
 // Up to `max_parts` pieces of the input; the last piece takes the rest.
 inline std::vector<std::string> Split(const uint8_t* data, size_t size, size_t max_parts) {

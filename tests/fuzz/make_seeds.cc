@@ -7,7 +7,11 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
+#include "device/program_binary_cache.h"
 #include "fuzz_util.h"
 #include "sapmvs/block/export_frame.h"
 #include "sapmvs/io/las_io.h"
@@ -201,6 +205,27 @@ void CloudSeeds(const fs::path& out) {
   WriteLas(out / "las" / "extra_bytes_14.las", ToLasRecords(cloud), o, ToLasExtras(cloud));
 }
 
+// Two whole entries of the program cache target's key, as Store writes them.
+void ProgramCacheSeeds(const fs::path& out) {
+  const fs::path tmp = out / "program_cache_tmp";
+  const ProgramBinaryCache cache(tmp);
+  fs::create_directories(out / "program_cache");
+  const std::string key(fuzz::kProgramCacheKey);
+  const std::string binaries[] = {std::string("\x7f"
+                                              "ELF binary\0\1\2",
+                                              15),
+                                  std::string(300, 'b')};
+  int n = 0;
+  for (const std::string& b : binaries) {
+    if (!cache.Store(key, std::vector<unsigned char>(b.begin(), b.end()))) {
+      throw std::runtime_error("cannot store a program cache seed in " + tmp.string());
+    }
+    fs::copy_file(cache.EntryPath(key), out / "program_cache" / ("entry" + std::to_string(n++)),
+                  fs::copy_options::overwrite_existing);
+  }
+  fs::remove_all(tmp);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -211,6 +236,7 @@ int main(int argc, char** argv) {
   try {
     ColmapSeeds(argv[1]);
     CloudSeeds(argv[1]);
+    ProgramCacheSeeds(argv[1]);
   } catch (const std::exception& e) {
     std::cerr << "make_seeds: " << e.what() << "\n";
     return 1;
