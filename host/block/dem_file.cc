@@ -9,13 +9,14 @@
 #include <memory>
 
 #include "sapmvs/util/error.h"
+#include "util/gdal_drivers.h"
 #include "util/input_file.h"
 
 namespace sapmvs {
 
 Dem Dem::Load(const std::filesystem::path& path) {
   RequireRegularFile(path);
-  GDALAllRegister();
+  RegisterAllGdalDrivers();
   // GTiff decodes the blocks of one RasterIO call on all cores (GDAL >= 3.6;
   // other drivers and older versions ignore it, and a config option, unlike
   // an open option, warns for none): a simulated block's DEM is its 0.11 m

@@ -11,7 +11,9 @@ extern "C" __attribute__((visibility("default"))) const sapmvs::GdalModuleFuncti
 sapmvs_gdal_module() {
   using namespace sapmvs;
   static const GdalModuleFunctions table = [] {
-    GDALAllRegister();
+    // No drivers here: each function registers those it needs
+    // (util/gdal_drivers.h), so that writing the outputs does not register
+    // every driver.
     // GDAL's warnings become detail lines, its failures part of our messages.
     InstallGdalMessageHandler();
     GdalModuleFunctions t;

@@ -18,6 +18,7 @@
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
+#include "util/gdal_drivers.h"
 #include "util/gdal_messages.h"
 
 namespace sapmvs {
@@ -45,7 +46,7 @@ void CheckRaster(const std::filesystem::path& path, const GeoRaster& r) {
 
 void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& raster,
                const OGRSpatialReference* srs) {
-  GDALAllRegister();
+  RegisterGdalDriver("GTiff");
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
   if (!driver) throw Error(file + ": GDAL has no GTiff driver");
   QuietGdalErrors quiet;
@@ -77,7 +78,7 @@ void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const 
 // RGB with an alpha band, so GIS shows nodata as transparent.
 void WriteRgbaTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& grid,
                    const OGRSpatialReference* srs, const std::vector<uint8_t>& rgba) {
-  GDALAllRegister();
+  RegisterGdalDriver("GTiff");
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
   if (!driver) throw Error(file + ": GDAL has no GTiff driver");
   QuietGdalErrors quiet;
@@ -255,7 +256,7 @@ std::string CrsLinearUnit(const std::string& crs) {
 
 GeoRaster ReadGeoRaster(const std::filesystem::path& path) {
   const std::string file = path.string();
-  GDALAllRegister();
+  RegisterAllGdalDrivers();
   QuietGdalErrors quiet;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {

@@ -19,6 +19,7 @@
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
+#include "util/gdal_drivers.h"
 #include "util/image_codec.h"
 
 namespace sapmvs {
@@ -236,7 +237,7 @@ DsmPictures WriteDsmPictures(const GeoRaster& dsm, const std::filesystem::path& 
   std::sort(valid.begin(), valid.end());
   const double lo = valid[valid.size() / 100];
   const double hi = std::max(lo + 1e-3, static_cast<double>(valid[valid.size() * 99 / 100]));
-  GDALAllRegister();
+  RegisterGdalDriver("MEM");
   const std::vector<uint8_t> rgba = ShadedRelief(dsm, lo, hi, color_tif.string());
 
   DsmPictures out{color_tif, png, std::filesystem::path(png).replace_extension(".pgw")};

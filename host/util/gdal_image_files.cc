@@ -4,20 +4,15 @@
 #include <gdal_priv.h>
 
 #include <atomic>
-#include <mutex>
 #include <opencv2/core.hpp>
 
 #include "sapmvs/util/error.h"
+#include "util/gdal_drivers.h"
 #include "util/gdal_messages.h"
 #include "util/image_codec.h"
 
 namespace sapmvs {
 namespace {
-
-void RegisterDriversOnce() {
-  static std::once_flag once;
-  std::call_once(once, [] { GDALAllRegister(); });
-}
 
 const char* DriverName(ImageEncoding encoding) {
   switch (encoding) {
@@ -63,7 +58,7 @@ cv::Mat ExpandPalette(GDALRasterBand* band, const std::string& file) {
 }  // namespace
 
 cv::Mat DecodeImageWithGdal(const std::filesystem::path& path) {
-  RegisterDriversOnce();
+  RegisterAllGdalDrivers();
   const std::string file = path.string();
   QuietGdalErrors quiet;
   DatasetPtr ds(GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
@@ -97,7 +92,8 @@ cv::Mat DecodeImageWithGdal(const std::filesystem::path& path) {
 
 std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encoding,
                                        const std::string& what, int jpeg_quality) {
-  RegisterDriversOnce();
+  RegisterGdalDriver("MEM");
+  RegisterGdalDriver(DriverName(encoding));
   if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
     throw Error(what + ": cannot encode image (expected 8-bit BGR or grey pixels)");
   }
@@ -146,7 +142,7 @@ std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encod
 }
 
 cv::Size ReadImageSizeWithGdal(const std::filesystem::path& path) {
-  RegisterDriversOnce();
+  RegisterAllGdalDrivers();
   const std::string file = path.string();
   QuietGdalErrors quiet;
   DatasetPtr ds(GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
@@ -161,7 +157,7 @@ cv::Size ReadImageSizeWithGdal(const std::filesystem::path& path) {
 }
 
 bool CanEncode(ImageEncoding encoding) {
-  RegisterDriversOnce();
+  RegisterGdalDriver(DriverName(encoding));
   return GetGDALDriverManager()->GetDriverByName(DriverName(encoding)) != nullptr;
 }
 
