@@ -144,7 +144,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   PatchKernelsOptions kernel_options;
   kernel_options.device = DeviceForLocalRank(options.device, dispatch.session().local_rank());
   kernel_options.profile = options.profile;
-  const std::unique_ptr<PatchKernels> kernels = MakePatchKernels(kernel_options);
+  std::unique_ptr<PatchKernels> kernels = MakePatchKernels(kernel_options);
   const KernelDevice& device = kernels->device();
   report.device = device.description;
   report.device_info = {device.name, device.vendor, device.platform, device.type};
@@ -238,6 +238,10 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   progress.Finish();
   const std::vector<int> matched_by = dispatch.Finish(n);
   end_stage("match");
+  // The device's buffers, queues and programs are not needed by the merge,
+  // and the outputs' peak comes after it, once GDAL is loaded.
+  kernels.reset();
+  ReleaseFreeMemory();
   if (!dispatch.merges()) return report;
   for (GroupRun& run : report.groups) {
     run.rank = report.ranks > 1 ? matched_by[run.index] : -1;
