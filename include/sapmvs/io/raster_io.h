@@ -88,8 +88,9 @@ class GeoOutputsCheck {
 // The resident memory that loading GDAL to write the outputs will add: 0
 // where GDAL is linked in or already loaded, and in the binary, before it
 // loads its GDAL module, what GDAL and its libraries held at the end of a
-// run on `small` (37 MiB), rounded up. Plans count it as part of the
-// process, so that a memory budget also bounds the outputs' peak.
+// run on `small` (30 MiB, with the drivers the outputs register), rounded
+// up. Plans count it as part of the process, so that a memory budget also
+// bounds the outputs' peak.
 double GdalBytesToLoad();
 
 // How a report names a CRS: its EPSG code (0 when it has none that PROJ can
