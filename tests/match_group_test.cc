@@ -225,6 +225,43 @@ class MatchGroupTest : public test::ClTest {
     }
     EXPECT_EQ(bad, 0);
   }
+
+  // Each point's colour is the pixel it projects to in one of the group's
+  // images at the matched level (its reference's, read again from the file
+  // once the points are known), or within `reach` pixels of it (a pmvs-mode
+  // point takes its cell's pixel, which its refined centre may leave by up
+  // to a pixel): a colour from another image or place of these textured
+  // renderings would match only by chance.
+  static void ExpectColoursFromTheirImages(const PointCloud& cloud, int level, int reach) {
+    const Block block = ReadBlock(TinyDir() / "block.yaml");
+    const MatchGroupData group = LoadMatchGroup(block, {0, 1, 2, 3}, level, nullptr);
+    std::vector<cv::Mat> colors;
+    for (const MatchImage& im : group.images) colors.push_back(LoadColorAtLevel(block, im, level));
+    long found = 0;
+    for (const CloudPoint& p : cloud.points) {
+      const Eigen::Vector3d x = p.position - group.origin;
+      bool any = false;
+      for (size_t i = 0; i < group.images.size() && !any; ++i) {
+        const Camera& camera = group.images[i].camera;
+        const Eigen::Vector2d uv = camera.Project(x);
+        if (!camera.InImage(uv)) continue;
+        const int c = static_cast<int>(std::lround(uv.x()));
+        const int r = static_cast<int>(std::lround(uv.y()));
+        for (int dr = -reach; dr <= reach && !any; ++dr) {
+          for (int dc = -reach; dc <= reach && !any; ++dc) {
+            const cv::Vec3b bgr =
+                colors[i].at<cv::Vec3b>(std::clamp(r + dr, 0, colors[i].rows - 1),
+                                        std::clamp(c + dc, 0, colors[i].cols - 1));
+            any = bgr[2] == p.color[0] && bgr[1] == p.color[1] && bgr[0] == p.color[2];
+          }
+        }
+      }
+      found += any;
+    }
+    std::printf("[ colours  ] %ld of %zu points have their image's pixel colour\n", found,
+                cloud.points.size());
+    EXPECT_GE(found, 0.99 * static_cast<double>(cloud.points.size()));
+  }
 };
 
 // Acceptance floors against truth/dsm.tif. Measured on PoCL (tiny preset,
@@ -274,6 +311,7 @@ TEST_F(MatchGroupTest, SapmvsModeMatchesTheTrueSurface) {
   }
   ExpectMeetsFloors(m, {30000, 0.85, 0.45, 0.58});
   ExpectPointsWellFormed(m.result.cloud, o);
+  ExpectColoursFromTheirImages(m.result.cloud, o.level, 0);
 }
 
 TEST_F(MatchGroupTest, PmvsModeMatchesTheTrueSurface) {
@@ -289,6 +327,7 @@ TEST_F(MatchGroupTest, PmvsModeMatchesTheTrueSurface) {
   for (const auto& [size, count] : s.accepted_by_size) EXPECT_EQ(size, o.window_size);
   ExpectMeetsFloors(m, {8000, 0.9, 0.4, 0.63});
   ExpectPointsWellFormed(m.result.cloud, o);
+  ExpectColoursFromTheirImages(m.result.cloud, o.level, 1);
 }
 
 // The group's grey images lie in one page-aligned block, one after the

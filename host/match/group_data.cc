@@ -51,7 +51,6 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
     const cv::Mat bgr =
         ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
-    im.color = bgr;
     cv::cvtColor(bgr, grey8[group.images.size()], cv::COLOR_BGR2GRAY);
     const bool have = geometry.images.size() > static_cast<size_t>(id) && geometry.images[id].valid;
     im.depth = have ? geometry.images[id].depth : fallback_depth;
@@ -104,6 +103,11 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     group.ncc.cameras.push_back(MakeNccCamera(im.camera, im.name.c_str()));
   }
   return group;
+}
+
+cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level) {
+  const LoadedImage loaded = LoadUndistorted(block.images.at(image.block_index));
+  return ResampleToLevel(loaded.pixels, level, image.camera.width(), image.camera.height());
 }
 
 void SelectViews(const MatcherOptions& /*options*/, MatchGroupData* group) {

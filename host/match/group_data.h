@@ -23,7 +23,6 @@ struct MatchImage {
   // CV_32F, grey levels 0..255; a view into the group's one block of pixels,
   // which MatchGroupData::ncc.pixels owns (LoadMatchGroup).
   cv::Mat grey;
-  cv::Mat color;           // CV_8UC3, BGR
   std::vector<int> views;  // other images of the group to match with, best first
   double depth = 0;        // expected scene depth along the optical axis
   // False for a view-only image (another strip's, ImageGroup::views): patches
@@ -46,6 +45,12 @@ struct MatchGroupData {
 // block's DEM each time), else nullptr and it is estimated here.
 MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
                               const BlockGeometry* geometry = nullptr);
+
+// The colour pixels of group image `image` (CV_8UC3, BGR), read again from
+// its file as LoadMatchGroup read it: the group keeps only grey levels
+// through the matching, and its points take their colours once they are
+// known. Throws Error naming the image for an unreadable file.
+cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level);
 
 // Picks each image's views: images whose footprint overlaps its own at the
 // expected depth, most overlap first, at most kMaxViews - 1. As in PMVS2,

@@ -45,12 +45,13 @@ MatcherMemoryModel MatcherMemory() {
   MatcherMemoryModel m;
   // grouping.h EstimateGroupMemory spells out each term.
   m.device_bytes_per_pixel = sizeof(float);
-  m.host_bytes_per_pixel = 3 + sizeof(float) + 1;
+  m.host_bytes_per_pixel = sizeof(float) + 1;
   // Fitted, not summed: the patches and points a cell ends up with, and the
   // filter's arrays over them, depend on how much of the images matches.
-  // With 72 bytes a cell (30 bytes a pixel in all), every group of the
-  // seven blocks of profiling/results/memory.md ("Refitted") is estimated
-  // 5 to 20 % above its measured peak.
+  // With 72 bytes a cell (27 bytes a pixel in all), every group of the
+  // five presets is estimated 14 to 21 % above its measured peak, and
+  // Herz-Jesu-P8's 45 to 54 % (profiling/results/memory.md, "Colours read
+  // at the end").
   m.host_bytes_per_cell = 72;
   m.device_bytes_per_candidate = batch.per_patch + views * batch.per_pair;
   m.host_bytes_per_candidate =
@@ -263,21 +264,37 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   cloud.has_normals = cloud.has_colors = cloud.has_scores = cloud.has_views = true;
   cloud.crs = block.crs;
   cloud.points.reserve(std::count(keep.begin(), keep.end(), true));
+  std::vector<bool> has_points(group.images.size(), false);
   for (size_t i = 0; i < points.size(); ++i) {
     if (!keep[i]) continue;
     const DensePoint& d = points[i];
     const AcceptedPatch& p = patches[d.patch];
-    const MatchImage& ref = group.images[p.ref];
     CloudPoint c;
     c.position = d.x + group.origin;
     c.normal = p.normal.cast<float>();
-    const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, ref.color.cols - 1);
-    const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, ref.color.rows - 1);
-    const cv::Vec3b bgr = ref.color.at<cv::Vec3b>(y, x);
-    c.color = {bgr[2], bgr[1], bgr[0]};
     c.score = p.score;
     c.num_views = 1 + static_cast<int>(p.views.size());
     cloud.points.push_back(c);
+    has_points[p.ref] = true;
+  }
+  // The colours, one reference image at a time, read again from its file:
+  // held from the load on, the colour images were 3 bytes a pixel of the
+  // level through the whole matching (38 MiB of Herz-Jesu-P8's 382 MiB
+  // peak), for a read here that costs what the load's did.
+  for (size_t r = 0; r < group.images.size(); ++r) {
+    if (!has_points[r]) continue;
+    const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level);
+    size_t j = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (!keep[i]) continue;
+      CloudPoint& c = cloud.points[j++];
+      const DensePoint& d = points[i];
+      if (patches[d.patch].ref != static_cast<int>(r)) continue;
+      const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, color.cols - 1);
+      const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, color.rows - 1);
+      const cv::Vec3b bgr = color.at<cv::Vec3b>(y, x);
+      c.color = {bgr[2], bgr[1], bgr[0]};
+    }
   }
   stats.points = static_cast<long>(cloud.points.size());
   stats.kernels = engine.kernel_times();

@@ -46,15 +46,17 @@ struct GroupMemory {
 //          + M (48 + 48 + 4 + 16 (V - 1))     one wave: NccPatch, refined
 //                                             patch, view offset, and per
 //                                             view a pair, an index, a score
-//   host   = sum_i (8 P_i + 72 C_i)           BGR 8-bit + float32 grey +
-//                                             edge mask, and per cell 72
+//   host   = sum_i (5 P_i + 72 C_i)           float32 grey + edge mask
+//                                             (colours are read again at
+//                                             the end), and per cell 72
 //                                             bytes, fitted to the measured
 //                                             peaks: the cell grids, the
 //                                             accepted patches and dense
 //                                             points, the filter's arrays
 //                                             (MatcherMemory says how)
 //          + M (candidate + result + 4 (V - 1))   the wave's host side
-//          + max_i 6 w_i h_i                 loading: one full-resolution
+//          + max_i 6 w_i h_i                 loading (and the colours'
+//                                             read): one full-resolution
 //                                             BGR image, raw + undistorted
 // with V = kMaxViews and w_i h_i the full-resolution size. The per-image
 // terms grow linearly with the images and by 4x per level towards full
