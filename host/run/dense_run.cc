@@ -145,9 +145,12 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   kernel_options.device = DeviceForLocalRank(options.device, dispatch.session().local_rank());
   kernel_options.profile = options.profile;
   std::unique_ptr<PatchKernels> kernels = MakePatchKernels(kernel_options);
-  const KernelDevice& device = kernels->device();
-  report.device = device.description;
-  report.device_info = {device.name, device.vendor, device.platform, device.type};
+  {
+    // Scoped: `kernels` is released once the matching ends.
+    const KernelDevice& device = kernels->device();
+    report.device = device.description;
+    report.device_info = {device.name, device.vendor, device.platform, device.type};
+  }
   LogDetail("device: " + report.device);
 
   // What the process holds before any group, once what planning freed is
