@@ -46,6 +46,9 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     const BlockImage& bi = block.images.at(id);
     LoadedImage loaded = LoadUndistorted(bi);
     MatchImage im;
+    std::error_code ec;
+    im.file_size = std::filesystem::file_size(bi.path, ec);
+    im.file_time = std::filesystem::last_write_time(bi.path, ec);
     im.name = bi.name;
     im.block_index = id;
     im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
@@ -106,7 +109,16 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
 }
 
 cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level) {
-  const LoadedImage loaded = LoadUndistorted(block.images.at(image.block_index));
+  const BlockImage& bi = block.images.at(image.block_index);
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(bi.path, ec);
+  const std::filesystem::file_time_type time = std::filesystem::last_write_time(bi.path, ec);
+  if (!ec && (size != image.file_size || time != image.file_time)) {
+    throw Error(bi.path.string() +
+                ": image file changed while its group was matched (expected the file that "
+                "was loaded: its points take their colours from it)");
+  }
+  const LoadedImage loaded = LoadUndistorted(bi);
   return ResampleToLevel(loaded.pixels, level, image.camera.width(), image.camera.height());
 }
 

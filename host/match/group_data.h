@@ -3,6 +3,8 @@
 // level, pinhole cameras in the block's local frame, the views each image is
 // matched with, and the depth range its scene is expected in.
 #include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -23,6 +25,10 @@ struct MatchImage {
   // CV_32F, grey levels 0..255; a view into the group's one block of pixels,
   // which MatchGroupData::ncc.pixels owns (LoadMatchGroup).
   cv::Mat grey;
+  // The image file's size and time when it was loaded: LoadColorAtLevel reads
+  // it again and refuses a file that has changed since.
+  std::uintmax_t file_size = 0;
+  std::filesystem::file_time_type file_time{};
   std::vector<int> views;  // other images of the group to match with, best first
   double depth = 0;        // expected scene depth along the optical axis
   // False for a view-only image (another strip's, ImageGroup::views): patches
@@ -49,7 +55,9 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
 // The colour pixels of group image `image` (CV_8UC3, BGR), read again from
 // its file as LoadMatchGroup read it: the group keeps only grey levels
 // through the matching, and its points take their colours once they are
-// known. Throws Error naming the image for an unreadable file.
+// known. Throws Error naming the image for an unreadable file, or one whose
+// size or time differ from the load's (replaced during the run: its pixels
+// would not be the ones matched).
 cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level);
 
 // Picks each image's views: images whose footprint overlaps its own at the
