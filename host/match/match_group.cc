@@ -280,32 +280,26 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   // The colours, from each reference image read again from its file: held
   // from the load on, the colour images were 3 bytes a pixel of the level
   // through the whole matching (38 MiB of Herz-Jesu-P8's 382 MiB peak), for
-  // a read here that costs what the load's did. Two images at a time, so
-  // that both cores read (0.42 s on one core on Herz-Jesu-P8), and no more:
-  // each holds its full-resolution image while it reads, when the filter's
-  // neighbour table (64 bytes a point) is gone.
-  std::vector<int> with_points;
-  for (size_t r = 0; r < group.images.size(); ++r) {
-    if (has_points[r]) with_points.push_back(static_cast<int>(r));
+  // a read here that costs what the load's did (0.42 s on Herz-Jesu-P8).
+  // One image at a time, as the load reads them: each holds its
+  // full-resolution pixels, and an undistorted copy, while it reads (the
+  // plan counts one such image). Two at a time took ODM's 4 images at
+  // level 2 from a peak of 159 to 177 MiB.
+  for (int r = 0; r < static_cast<int>(group.images.size()); ++r) {
+    if (!has_points[r]) continue;
+    const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level);
+    size_t j = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (!keep[i]) continue;
+      CloudPoint& c = cloud.points[j++];
+      const DensePoint& d = points[i];
+      if (patches[d.patch].ref != r) continue;
+      const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, color.cols - 1);
+      const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, color.rows - 1);
+      const cv::Vec3b bgr = color.at<cv::Vec3b>(y, x);
+      c.color = {bgr[2], bgr[1], bgr[0]};
+    }
   }
-  ParallelFor(
-      static_cast<long>(with_points.size()),
-      [&](long k) {
-        const int r = with_points[k];
-        const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level);
-        size_t j = 0;
-        for (size_t i = 0; i < points.size(); ++i) {
-          if (!keep[i]) continue;
-          CloudPoint& c = cloud.points[j++];
-          const DensePoint& d = points[i];
-          if (patches[d.patch].ref != r) continue;
-          const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, color.cols - 1);
-          const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, color.rows - 1);
-          const cv::Vec3b bgr = color.at<cv::Vec3b>(y, x);
-          c.color = {bgr[2], bgr[1], bgr[0]};
-        }
-      },
-      /*block=*/1, /*max_threads=*/2);
   stats.points = static_cast<long>(cloud.points.size());
   stats.kernels = engine.kernel_times();
   end_stage("output");
