@@ -46,8 +46,7 @@ void CheckRaster(const std::filesystem::path& path, const GeoRaster& r) {
 
 void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& raster,
                const OGRSpatialReference* srs) {
-  RegisterGdalDriver("GTiff");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  GDALDriver* driver = GdalDriver("GTiff");
   if (!driver) throw Error(file + ": GDAL has no GTiff driver");
   QuietGdalErrors quiet;
   CPLStringList options;
@@ -78,8 +77,7 @@ void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const 
 // RGB with an alpha band, so GIS shows nodata as transparent.
 void WriteRgbaTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& grid,
                    const OGRSpatialReference* srs, const std::vector<uint8_t>& rgba) {
-  RegisterGdalDriver("GTiff");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  GDALDriver* driver = GdalDriver("GTiff");
   if (!driver) throw Error(file + ": GDAL has no GTiff driver");
   QuietGdalErrors quiet;
   CPLStringList options;

@@ -61,7 +61,7 @@ cv::Vec3b Ramp(double t) {
 
 // A MEM dataset of the DSM, for GDAL's DEM tools.
 Dataset MemDsm(const GeoRaster& dsm, const std::string& file) {
-  GDALDriverH mem = GDALGetDriverByName("MEM");
+  GDALDriverH mem = GDALDriver::ToHandle(GdalDriver("MEM"));
   if (!mem) throw Error(file + ": GDAL has no MEM driver");
   Dataset ds(GDALCreate(mem, "", dsm.width, dsm.height, 1, GDT_Float32, nullptr));
   if (!ds) throw Error(file + ": GDAL cannot hold the DSM in memory");
@@ -237,7 +237,6 @@ DsmPictures WriteDsmPictures(const GeoRaster& dsm, const std::filesystem::path& 
   std::sort(valid.begin(), valid.end());
   const double lo = valid[valid.size() / 100];
   const double hi = std::max(lo + 1e-3, static_cast<double>(valid[valid.size() * 99 / 100]));
-  RegisterGdalDriver("MEM");
   const std::vector<uint8_t> rgba = ShadedRelief(dsm, lo, hi, color_tif.string());
 
   DsmPictures out{color_tif, png, std::filesystem::path(png).replace_extension(".pgw")};

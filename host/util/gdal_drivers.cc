@@ -1,7 +1,7 @@
 #include "util/gdal_drivers.h"
 
-#include <gdal.h>
 #include <gdal_frmts.h>
+#include <gdal_priv.h>
 
 #include <mutex>
 
@@ -27,7 +27,7 @@ void RegisterAllGdalDrivers() {
   all = true;
 }
 
-void RegisterGdalDriver(const std::string& name) {
+GDALDriver* GdalDriver(const std::string& name) {
   void (*reg)() = nullptr;
   if (name == "GTiff") reg = &GDALRegister_GTiff;
   if (name == "PNG") reg = &GDALRegister_PNG;
@@ -35,9 +35,10 @@ void RegisterGdalDriver(const std::string& name) {
   if (name == "MEM") reg = &GDALRegister_MEM;
   if (name == "PNM") reg = &GDALRegister_PNM;
   if (name == "BMP") reg = &GDALRegister_BMP;
-  if (!reg) throw Error("RegisterGdalDriver: no built-in GDAL driver '" + name + "'");
+  if (!reg) throw Error("GdalDriver: no built-in GDAL driver '" + name + "'");
   std::lock_guard<std::mutex> lock(RegistrationMutex());
   reg();
+  return GetGDALDriverManager()->GetDriverByName(name.c_str());
 }
 
 }  // namespace sapmvs

@@ -7,14 +7,17 @@
 // (images, DEMs, rasters of any format) needs them all.
 #include <string>
 
+class GDALDriver;
+
 namespace sapmvs {
 
-// Every driver, once per process. Thread-safe, as RegisterGdalDriver.
+// Every driver, once per process. Thread-safe, as GdalDriver.
 void RegisterAllGdalDrivers();
 
-// One driver GDAL builds in: "GTiff", "PNG", "JPEG", "MEM", "PNM" or "BMP".
+// One driver GDAL builds in, registered first: "GTiff", "PNG", "JPEG",
+// "MEM", "PNM" or "BMP"; nullptr when this GDAL was built without it.
 // Throws Error for another name (a programming error: the others are only
 // reached through RegisterAllGdalDrivers). Registering twice is harmless.
-void RegisterGdalDriver(const std::string& name);
+GDALDriver* GdalDriver(const std::string& name);
 
 }  // namespace sapmvs

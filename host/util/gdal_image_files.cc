@@ -92,13 +92,11 @@ cv::Mat DecodeImageWithGdal(const std::filesystem::path& path) {
 
 std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encoding,
                                        const std::string& what, int jpeg_quality) {
-  RegisterGdalDriver("MEM");
-  RegisterGdalDriver(DriverName(encoding));
   if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
     throw Error(what + ": cannot encode image (expected 8-bit BGR or grey pixels)");
   }
-  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(DriverName(encoding));
+  GDALDriver* mem = GdalDriver("MEM");
+  GDALDriver* driver = GdalDriver(DriverName(encoding));
   if (!mem || !driver) {
     throw Error(what + ": cannot encode image (GDAL has no " + DriverName(encoding) + " driver)");
   }
@@ -156,9 +154,6 @@ cv::Size ReadImageSizeWithGdal(const std::filesystem::path& path) {
   return {ds->GetRasterXSize(), ds->GetRasterYSize()};
 }
 
-bool CanEncode(ImageEncoding encoding) {
-  RegisterGdalDriver(DriverName(encoding));
-  return GetGDALDriverManager()->GetDriverByName(DriverName(encoding)) != nullptr;
-}
+bool CanEncode(ImageEncoding encoding) { return GdalDriver(DriverName(encoding)) != nullptr; }
 
 }  // namespace sapmvs
