@@ -1,8 +1,10 @@
 #include "sapmvs/match/match_group.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -35,6 +37,30 @@ double DeviceSeconds(const PatchEngine& engine) {
   double s = 0;
   for (const auto& [name, t] : engine.kernel_times()) s += t.seconds;
   return s;
+}
+
+// The colour at `uv` of an 8-bit BGR image, bilinear between the pixels
+// around it (border pixels repeated), as RGB. A sapmvs-mode point lies on a
+// pixel and takes that pixel's colour; a pmvs-mode point lies at its cell's
+// centre, a pixel corner, where rounding to one of the four pixels picked
+// whichever the float32 projection fell nearer.
+std::array<uint8_t, 3> ColourAt(const cv::Mat& bgr, const Eigen::Vector2f& uv) {
+  const double x = std::clamp(static_cast<double>(uv.x()), 0.0, bgr.cols - 1.0);
+  const double y = std::clamp(static_cast<double>(uv.y()), 0.0, bgr.rows - 1.0);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int x1 = std::min(x0 + 1, bgr.cols - 1), y1 = std::min(y0 + 1, bgr.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  const cv::Vec3b& a = bgr.at<cv::Vec3b>(y0, x0);
+  const cv::Vec3b& b = bgr.at<cv::Vec3b>(y0, x1);
+  const cv::Vec3b& c = bgr.at<cv::Vec3b>(y1, x0);
+  const cv::Vec3b& d = bgr.at<cv::Vec3b>(y1, x1);
+  std::array<uint8_t, 3> rgb;
+  for (int k = 0; k < 3; ++k) {
+    const double top = a[k] + fx * (b[k] - a[k]);
+    const double bottom = c[k] + fx * (d[k] - c[k]);
+    rgb[2 - k] = static_cast<uint8_t>(std::lround(top + fy * (bottom - top)));
+  }
+  return rgb;
 }
 
 }  // namespace
@@ -294,10 +320,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
       CloudPoint& c = cloud.points[j++];
       const DensePoint& d = points[i];
       if (patches[d.patch].ref != r) continue;
-      const int x = std::clamp(static_cast<int>(std::lround(d.uv.x())), 0, color.cols - 1);
-      const int y = std::clamp(static_cast<int>(std::lround(d.uv.y())), 0, color.rows - 1);
-      const cv::Vec3b bgr = color.at<cv::Vec3b>(y, x);
-      c.color = {bgr[2], bgr[1], bgr[0]};
+      c.color = ColourAt(color, d.uv);
     }
   }
   stats.points = static_cast<long>(cloud.points.size());
