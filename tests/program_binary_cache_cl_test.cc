@@ -2,7 +2,9 @@
 // later contexts and runs load them and compute the same (the file format,
 // the folder and the key: program_binary_cache_test.cc, a host test).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -129,15 +131,26 @@ TEST_F(ProgramBinaryCacheRunTest, ARunKeepsItsKernelsAndTheNextLoadsThemForTheSa
   ASSERT_EQ(first.exit_code, 0) << first.err;
   const std::vector<fs::path> kept = test::FolderEntries(cache);
   ASSERT_FALSE(kept.empty());
-  std::vector<fs::file_time_type> written;
-  for (const fs::path& f : kept) written.push_back(fs::last_write_time(f));
+  // A store writes a new file and renames it over the entry (AtomicFile),
+  // so an entry built again is another inode; a load sets its time.
+  const auto inode = [](const fs::path& f) {
+    struct stat st {};
+    return ::stat(f.c_str(), &st) == 0 ? st.st_ino : ino_t{0};
+  };
+  std::vector<ino_t> written;
+  const auto before = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const fs::path& f : kept) {
+    written.push_back(inode(f));
+    fs::last_write_time(f, before);
+  }
 
   const auto second =
       test::RunCli("run " + block.string() + " --out " + (dir_ / "b").string() + " -q", env);
   ASSERT_EQ(second.exit_code, 0) << second.err;
   ASSERT_EQ(test::FolderEntries(cache), kept);
   for (size_t i = 0; i < kept.size(); ++i) {
-    EXPECT_EQ(fs::last_write_time(kept[i]), written[i]) << kept[i] << " was built again";
+    EXPECT_EQ(inode(kept[i]), written[i]) << kept[i] << " was built again";
+    EXPECT_GT(fs::last_write_time(kept[i]), before) << kept[i] << " not marked used";
   }
   const std::string cloud = test::Slurp(dir_ / "a" / "cloud.ply");
   ASSERT_FALSE(cloud.empty());

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -81,6 +82,46 @@ TEST_F(ProgramBinaryCacheTest, StoreFailsQuietlyWhereNoFolderCanBeMade) {
   EXPECT_FALSE(off.Load("key").has_value());
   EXPECT_FALSE(ProgramBinaryCache(dir_).Store("key", {}));  // nothing to keep
   EXPECT_EQ(test::FolderEntries(dir_).size(), 1u);
+}
+
+TEST_F(ProgramBinaryCacheTest, KeepsTheFolderUnderItsSizeDroppingTheLeastRecentlyUsed) {
+  const fs::path folder = dir_ / "programs";
+  const std::vector<unsigned char> binary(1000, 7);
+  // Room for three entries of this size, not four.
+  const ProgramBinaryCache probe(folder);
+  ASSERT_TRUE(probe.Store("probe", binary));
+  const uintmax_t entry = fs::file_size(probe.EntryPath("probe"));
+  fs::remove(probe.EntryPath("probe"));
+  const ProgramBinaryCache cache(folder, 3 * entry + entry / 2);
+  // Files that are not entries, which a user may keep in the folder they
+  // named, are never removed, whatever their size or age.
+  test::WriteFileBytes(folder / "notes.txt", std::string(5000, 'n'));
+  test::WriteFileBytes(folder / "0123456789ABCDEF.bin", std::string(5000, 'n'));
+  test::WriteFileBytes(folder / "0123456789abcdef.bin.tmp", std::string(5000, 'n'));
+  const auto now = fs::file_time_type::clock::now();
+  // Keys a (oldest), b, c stored in turn with their times an hour apart.
+  const std::vector<std::string> keys = {"a", "b", "c"};
+  for (size_t i = 0; i < keys.size(); ++i) {
+    ASSERT_TRUE(cache.Store(keys[i], binary));
+    fs::last_write_time(cache.EntryPath(keys[i]), now - std::chrono::hours(3 - i));
+  }
+  for (const std::string& k : keys) EXPECT_TRUE(fs::exists(cache.EntryPath(k))) << k;
+  // Using a makes b the least recently used: d's store removes b only.
+  ASSERT_TRUE(cache.Load("a").has_value());
+  EXPECT_GT(fs::last_write_time(cache.EntryPath("a")), now - std::chrono::minutes(1));
+  ASSERT_TRUE(cache.Store("d", binary));
+  EXPECT_TRUE(fs::exists(cache.EntryPath("a")));
+  EXPECT_FALSE(fs::exists(cache.EntryPath("b")));
+  EXPECT_TRUE(fs::exists(cache.EntryPath("c")));
+  EXPECT_TRUE(fs::exists(cache.EntryPath("d")));
+  EXPECT_EQ(test::FolderEntries(folder).size(), 6u);
+  // An entry larger than the whole size is kept once stored (the run that
+  // built it loads it next time), and the others make way for it.
+  const ProgramBinaryCache small(folder, entry);
+  ASSERT_TRUE(small.Store("e", std::vector<unsigned char>(3 * entry, 1)));
+  EXPECT_TRUE(fs::exists(small.EntryPath("e")));
+  for (const std::string k : {"a", "c", "d"}) EXPECT_FALSE(fs::exists(small.EntryPath(k))) << k;
+  EXPECT_EQ(test::FolderEntries(folder).size(), 4u);
 }
 
 TEST(ProgramCacheFolderTest, SettingThenEnvironmentThenUserCacheFolder) {

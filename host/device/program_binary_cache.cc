@@ -86,7 +86,8 @@ std::string ProgramCacheKey(const DeviceInfo& device, std::string_view options,
   return key;
 }
 
-ProgramBinaryCache::ProgramBinaryCache(std::filesystem::path folder) : folder_(std::move(folder)) {}
+ProgramBinaryCache::ProgramBinaryCache(std::filesystem::path folder, uintmax_t max_bytes)
+    : folder_(std::move(folder)), max_bytes_(max_bytes) {}
 
 std::filesystem::path ProgramBinaryCache::EntryPath(std::string_view key) const {
   return folder_ / (Hex(Fnv1a(key.data(), key.size())) + ".bin");
@@ -126,6 +127,7 @@ std::optional<std::vector<unsigned char>> ProgramBinaryCache::Load(std::string_v
   }
   const char* binary = body.data() + key_length;
   if (binary_sum != Hex(Fnv1a(binary, binary_length))) return std::nullopt;
+  std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), error);
   return std::vector<unsigned char>(binary, binary + binary_length);
 }
 
@@ -148,9 +150,51 @@ bool ProgramBinaryCache::Store(std::string_view key,
       out.write(reinterpret_cast<const char*>(binary.data()),
                 static_cast<std::streamsize>(binary.size()));
     });
-    return true;
   } catch (const std::exception&) {  // Error from the write, filesystem_error
     return false;
+  }
+  Prune(EntryPath(key));
+  return true;
+}
+
+void ProgramBinaryCache::Prune(const std::filesystem::path& keep) const {
+  namespace fs = std::filesystem;
+  struct Found {
+    fs::file_time_type time;
+    uintmax_t bytes;
+    fs::path path;
+  };
+  std::vector<Found> entries;
+  uintmax_t total = 0;
+  std::error_code error;
+  for (fs::directory_iterator it(folder_, error), end; !error && it != end; it.increment(error)) {
+    const fs::path& path = it->path();
+    const std::string name = path.filename().string();
+    // Only our entries' names (EntryPath): 16 hexadecimal digits and ".bin".
+    if (name.size() != 20 || name.compare(16, 4, ".bin") != 0 ||
+        name.find_first_not_of("0123456789abcdef") != 16) {
+      continue;
+    }
+    std::error_code e;
+    if (!it->is_regular_file(e)) continue;
+    // Either fails for an entry another run's prune removed meanwhile.
+    Found f{it->last_write_time(e), 0, path};
+    if (e) continue;
+    f.bytes = it->file_size(e);
+    if (e) continue;
+    total += f.bytes;
+    if (path != keep) entries.push_back(std::move(f));
+  }
+  if (error || total <= max_bytes_) return;
+  std::sort(entries.begin(), entries.end(), [](const Found& a, const Found& b) {
+    return a.time != b.time ? a.time < b.time : a.path < b.path;
+  });
+  for (const Found& f : entries) {
+    if (total <= max_bytes_) break;
+    // Another run may hold it open (it reads on) or have removed it.
+    std::error_code e;
+    fs::remove(f.path, e);
+    total -= f.bytes;
   }
 }
 

@@ -10,7 +10,13 @@
 // another program's, truncated or altered is ignored (and replaced once the
 // program is built from source), and a folder that cannot be made or
 // written leaves the run as it would be without a cache.
+//
+// Every new build of sapmvs, device, driver and option set adds entries
+// (about 2 MiB for a run's programs on PoCL), so the folder is kept under a
+// size: a store removes the entries used least recently (a load marks its
+// entry used) beyond it. Only files named as entries are ever removed.
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -34,10 +40,15 @@ std::filesystem::path ProgramCacheFolder(const std::string& setting);
 std::string ProgramCacheKey(const DeviceInfo& device, std::string_view options,
                             std::string_view source);
 
+// The size a cache folder is kept under: some thirty sets of a run's
+// programs on PoCL.
+inline constexpr uintmax_t kProgramCacheBytes = uintmax_t{64} << 20;
+
 class ProgramBinaryCache {
  public:
   ProgramBinaryCache() = default;  // disabled
-  explicit ProgramBinaryCache(std::filesystem::path folder);
+  explicit ProgramBinaryCache(std::filesystem::path folder,
+                              uintmax_t max_bytes = kProgramCacheBytes);
 
   bool enabled() const { return !folder_.empty(); }
   const std::filesystem::path& folder() const { return folder_; }
@@ -46,14 +57,19 @@ class ProgramBinaryCache {
 
   // The binary stored for `key`; none without an entry, or when it cannot be
   // read or is not whole and `key`'s (its header's key, lengths and checksum).
+  // A whole entry's time is set to now, where the folder lets it.
   std::optional<std::vector<unsigned char>> Load(std::string_view key) const;
   // Stores `binary` for `key` in place of any entry, whole or not at all
-  // (AtomicFile), making the folder first. False when that fails (a
-  // read-only or full disk), which leaves no file behind.
+  // (AtomicFile), making the folder first, then removes the other entries
+  // with the oldest times until the entries fit in max_bytes. False when the
+  // store fails (a read-only or full disk), which leaves no file behind.
   bool Store(std::string_view key, const std::vector<unsigned char>& binary) const;
 
  private:
+  void Prune(const std::filesystem::path& keep) const;
+
   std::filesystem::path folder_;
+  uintmax_t max_bytes_ = kProgramCacheBytes;
 };
 
 }  // namespace sapmvs
