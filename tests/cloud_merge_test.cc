@@ -270,6 +270,44 @@ TEST(CloudMerge, CrossGroupPairsCountAsByBruteForce) {
   EXPECT_THROW(CountCrossGroupPairs(c, group_of, 0.1), Error);
 }
 
+// Points on a lattice of the radius's own spacing, so that pairs lie at
+// exactly the radius and on the grid's cube faces, at UTM-sized and at
+// negative coordinates: the grid finds every pair the brute force does.
+TEST(CloudMerge, PairsAtExactlyTheRadiusAreFoundAcrossCubeFaces) {
+  for (const double origin : {500000.0, -37.0}) {
+    PointCloud c;
+    std::vector<int> group_of;
+    const double r = 0.25;  // exact in binary, as are the lattice's offsets
+    for (int i = 0; i < 7; ++i) {
+      for (int j = 0; j < 7; ++j) {
+        for (int k = 0; k < 3; ++k) {
+          CloudPoint p;
+          p.position = {origin + i * r, 5400000.0 + j * r, k * r};
+          c.points.push_back(p);
+          group_of.push_back((i + j + k) % 2);
+        }
+      }
+    }
+    const long brute = CrossGroupPairsWithin(c, group_of, r);
+    EXPECT_GT(brute, 0);
+    EXPECT_EQ(CountCrossGroupPairs(c, group_of, r), brute) << origin;
+    // Each point of a sparser lattice has one partner, exactly the radius
+    // below it along one axis: across a cube face for some of them.
+    PointCloud a;
+    for (int i = 0; i < 9; ++i) {
+      CloudPoint p;
+      p.position = {origin + 3 * r * i, 5400000.0 + 3 * r * (i % 3), 3 * r * (i % 2)};
+      a.points.push_back(p);
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      PointCloud below = a;
+      for (CloudPoint& p : below.points) p.position[axis] -= r;
+      EXPECT_EQ(CountWithNeighbour(a, below, r), static_cast<long>(a.points.size()))
+          << origin << " axis " << axis;
+    }
+  }
+}
+
 TEST(CloudMerge, NeighbourCountIsAsByBruteForce) {
   PointCloud a, b;
   RandomPair(301, 3, 500000.0, &a, &b);
