@@ -46,9 +46,7 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
     const BlockImage& bi = block.images.at(id);
     LoadedImage loaded = LoadUndistorted(bi);
     MatchImage im;
-    std::error_code ec;
-    im.file_size = std::filesystem::file_size(bi.path, ec);
-    im.file_time = std::filesystem::last_write_time(bi.path, ec);
+    im.file = FileStamp::Of(bi.path).value_or(FileStamp{});
     im.name = bi.name;
     im.block_index = id;
     im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
@@ -108,12 +106,22 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
   return group;
 }
 
+std::optional<FileStamp> FileStamp::Of(const std::filesystem::path& path) {
+  std::error_code ec;
+  FileStamp stamp;
+  stamp.size = std::filesystem::file_size(path, ec);
+  if (ec) return std::nullopt;
+  stamp.time = std::filesystem::last_write_time(path, ec);
+  if (ec) return std::nullopt;
+  return stamp;
+}
+
 cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level) {
   const BlockImage& bi = block.images.at(image.block_index);
-  std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(bi.path, ec);
-  const std::filesystem::file_time_type time = std::filesystem::last_write_time(bi.path, ec);
-  if (!ec && (size != image.file_size || time != image.file_time)) {
+  // A file that cannot be stamped now is left to the read, which names
+  // what is wrong with it.
+  const std::optional<FileStamp> now = FileStamp::Of(bi.path);
+  if (now && *now != image.file) {
     throw Error(bi.path.string() +
                 ": image file changed while its group was matched (expected the file that "
                 "was loaded: its points take their colours from it)");

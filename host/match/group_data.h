@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,16 @@ namespace sapmvs {
 
 struct MatcherOptions;
 
+// A file's size and modification time, the two a replaced file changes.
+struct FileStamp {
+  std::uintmax_t size = 0;
+  std::filesystem::file_time_type time{};
+  bool operator==(const FileStamp& o) const { return size == o.size && time == o.time; }
+  bool operator!=(const FileStamp& o) const { return !(*this == o); }
+  // None where either cannot be read (a removed file).
+  static std::optional<FileStamp> Of(const std::filesystem::path& path);
+};
+
 struct MatchImage {
   std::string name;
   int block_index = -1;
@@ -25,10 +36,9 @@ struct MatchImage {
   // CV_32F, grey levels 0..255; a view into the group's one block of pixels,
   // which MatchGroupData::ncc.pixels owns (LoadMatchGroup).
   cv::Mat grey;
-  // The image file's size and time when it was loaded: LoadColorAtLevel reads
-  // it again and refuses a file that has changed since.
-  std::uintmax_t file_size = 0;
-  std::filesystem::file_time_type file_time{};
+  // The image file when it was loaded: LoadColorAtLevel reads it again and
+  // refuses a file that has changed since.
+  FileStamp file;
   std::vector<int> views;  // other images of the group to match with, best first
   double depth = 0;        // expected scene depth along the optical axis
   // False for a view-only image (another strip's, ImageGroup::views): patches
