@@ -439,6 +439,7 @@ TEST_F(MatchGroupTest, LargerSizesAreTriedWhereThePlaneAlreadyScoresTheGrowThres
 // patches into the cells the filter freed, which covers more of the ground.
 TEST_F(MatchGroupTest, LaterPassesGrowIntoTheCellsTheFilterFreed) {
   MatcherOptions o = Options(MatchMode::kSapmvs);
+  o.pmvs_passes = 0;  // adaptive passes only
   o.expand_iterations = 1;
   const Measured one = MatchAndCheck(o);
   o.expand_iterations = 3;
@@ -453,6 +454,23 @@ TEST_F(MatchGroupTest, LaterPassesGrowIntoTheCellsTheFilterFreed) {
   int propagation = 0;
   for (const auto& [name, t] : three.result.stats.stages) propagation += name == "propagation";
   EXPECT_EQ(propagation, 1);
+}
+
+// The last pass growing one-cell patches as PMVS does, in place of a third
+// adaptive one, covers ground the adaptive patches left at their accuracy.
+TEST_F(MatchGroupTest, APmvsPassCoversMoreAtTheSameAccuracy) {
+  MatcherOptions o = Options(MatchMode::kSapmvs);
+  o.pmvs_passes = 0;
+  const Measured adaptive = MatchAndCheck(o);
+  o.pmvs_passes = 1;
+  const Measured last = MatchAndCheck(o);
+  EXPECT_EQ(adaptive.result.stats.pmvs_pass_patches, 0);
+  EXPECT_GT(last.result.stats.pmvs_pass_patches, 0);
+  EXPECT_GT(last.check.cells_covered, adaptive.check.cells_covered);
+  EXPECT_GT(last.check.share_within, adaptive.check.share_within - 0.01);
+  // Their launches are counted with the others of the same size.
+  EXPECT_GT(last.result.stats.kernels.at("patch_refine 7x7").items,
+            adaptive.result.stats.kernels.at("patch_refine 7x7").items);
 }
 
 // The NGI aerial block at full resolution: the cloud follows the DEM, with no

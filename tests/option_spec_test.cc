@@ -149,6 +149,19 @@ TEST(OptionSpec, CannyThresholdsAndThresholdOrderAreChecked) {
   EXPECT_NE(o.Problem().find("threshold_before <= threshold"), std::string::npos) << o.Problem();
 }
 
+// The pmvs passes are the last of the expand-filter passes: no more of them.
+TEST(OptionSpec, PmvsPassesAreAtMostThePasses) {
+  MatcherOptions o;
+  o.expand_iterations = 2;
+  o.pmvs_passes = 2;
+  EXPECT_EQ(o.Problem(), "");
+  o.pmvs_passes = 3;
+  EXPECT_EQ(o.Problem(),
+            "pmvs_passes <= expand_iterations (pmvs_passes = 3, expand_iterations = 2)");
+  o.pmvs_passes = -1;
+  EXPECT_NE(o.Problem().find("pmvs_passes"), std::string::npos) << o.Problem();
+}
+
 // `run` takes the flags of four structs: no flag may be described twice.
 TEST(OptionSpec, FlagsAreUniqueAcrossRunsStructs) {
   std::map<std::string, std::string> seen;
@@ -274,6 +287,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   v1.refit_neighbours = 0;
   v1.refit_tolerance = 2;  // unused without the refit, so not recorded
   v1.refill_cut = true;    // likewise
+  v1.pmvs_passes = 0;
   EXPECT_EQ(OptionsJson(v1), old) << OptionsJson(v1).dump(2);
   const nlohmann::json defaults = OptionsJson(MatcherOptions{});
   EXPECT_NE(defaults, old);
@@ -281,12 +295,15 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   EXPECT_EQ(defaults["refit_neighbours"], 16);
   EXPECT_EQ(defaults["refit_tolerance"], 0.7);
   EXPECT_FALSE(defaults.contains("refill_cut"));
+  EXPECT_EQ(defaults["pmvs_passes"], 1);
   MatcherOptions refill;
   refill.refill_cut = true;
   EXPECT_EQ(OptionsJson(refill)["refill_cut"], true);
   MatcherOptions pmvs;
   pmvs.mode = MatchMode::kPmvs;
   EXPECT_EQ(OptionsJson(pmvs)["mode"], "pmvs");
+  // pmvs mode matches as before: its records resume.
+  EXPECT_FALSE(OptionsJson(pmvs).contains("pmvs_passes"));
   // A later option is recorded once it is set, so that a run matched with
   // it does not resume under another value.
   MatcherOptions sparse = v1;

@@ -157,10 +157,11 @@ int VariantsWithin(const std::vector<Options>& launched, const std::vector<Optio
   return static_cast<int>(used.size());
 }
 
-// MatchGroup builds EngineKernelVariants' programs ahead of the engine
-// (PatchKernels::Prepare): the engine must launch none other, in either
-// mode. Here every seed grows to 21 x 21, so sapmvs mode launches the 7 x 7
-// and the 21 x 21 variants (and would the others for seeds that stop between).
+// MatchGroup builds EngineKernelVariants' programs ahead of the engines
+// (PatchKernels::Prepare): they must launch none other, in either mode. Here
+// every seed grows to 21 x 21, so sapmvs mode launches the 7 x 7 and the
+// 21 x 21 variants (and would the others for seeds that stop between), and
+// its pmvs passes' engine (PmvsPassOptions) its own 7 x 7 ones.
 TEST_F(PatchEngineTest, LaunchesOnlyTheVariantsPreparedForIt) {
   const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
   const MatchGroupData group = test::MatchGroupOf(scene);
@@ -169,16 +170,25 @@ TEST_F(PatchEngineTest, LaunchesOnlyTheVariantsPreparedForIt) {
   for (const MatchMode mode : {MatchMode::kSapmvs, MatchMode::kPmvs}) {
     options.mode = mode;
     RecordingKernels kernels(NewKernels());
+    const bool sapmvs = mode == MatchMode::kSapmvs;
     {
       PatchEngine engine(kernels, group, options);
       engine.Evaluate(TiltedSeeds(scene, 12, 1.0, 6.0, 92));
     }
+    const MatcherOptions pmvs_pass = PmvsPassOptions(options);
+    if (sapmvs) {
+      PatchEngine engine(kernels, group, pmvs_pass);
+      engine.Evaluate(TiltedSeeds(scene, 12, 1.0, 6.0, 93));
+    }
     const EngineKernels variants = EngineKernelVariants(options);
-    const bool sapmvs = mode == MatchMode::kSapmvs;
-    EXPECT_EQ(variants.scorers.size(), sapmvs ? 4u : 1u);
-    EXPECT_EQ(variants.refiners.size(), sapmvs ? 4u : 1u);
-    EXPECT_EQ(VariantsWithin(kernels.scorers, variants.scorers), sapmvs ? 2 : 1);
-    EXPECT_EQ(VariantsWithin(kernels.refiners, variants.refiners), sapmvs ? 2 : 1);
+    EXPECT_EQ(variants.scorers.size(), sapmvs ? 5u : 1u);
+    EXPECT_EQ(variants.refiners.size(), sapmvs ? 5u : 1u);
+    EXPECT_EQ(VariantsWithin(kernels.scorers, variants.scorers), sapmvs ? 3 : 1);
+    EXPECT_EQ(VariantsWithin(kernels.refiners, variants.refiners), sapmvs ? 3 : 1);
+    // None of them without pmvs passes.
+    MatcherOptions adaptive_only = options;
+    adaptive_only.pmvs_passes = 0;
+    EXPECT_EQ(EngineKernelVariants(adaptive_only).scorers.size(), sapmvs ? 4u : 1u);
   }
 }
 

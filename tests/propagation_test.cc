@@ -218,21 +218,21 @@ TEST(WindowPixels, AMatchedEdgeLineIsABarrier) {
   for (const auto& [x, y] : got) EXPECT_LT(x + y, 44) << x << ", " << y;
 }
 
-// The points are reserved once, for as many as the reference cells can hold
-// (one per pixel, one per cell in pmvs mode), so that the waves append to
-// the array without copying it.
-TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
-  if (!UnwrittenMemoryIsFree()) {
-    GTEST_SKIP()
-        << "an address-space or data limit, or strict overcommit: the points are not reserved";
-  }
-  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
+// The scene as a group whose grey images (for the emission) are its pixels,
+// which must outlive it.
+MatchGroupData GroupWithGrey(test::PlaneScene& scene) {
   MatchGroupData group = test::MatchGroupOf(scene);
   for (size_t i = 0; i < group.images.size(); ++i) {
-    group.images[i].grey = cv::Mat(97, 121, CV_32F, scene.pixels[i].data());  // for the emission
+    const Camera& camera = scene.cameras[i];
+    group.images[i].grey = cv::Mat(camera.height(), camera.width(), CV_32F, scene.pixels[i].data());
   }
+  return group;
+}
+
+// `count` seeds of image 0, each with one candidate near the ground.
+std::vector<SeedFeature> SeedsInImage0(const test::PlaneScene& scene, int count) {
   std::vector<SeedFeature> seeds;
-  for (const test::PlaneStart& s : test::PerturbedStarts(scene, 6, 0.2, 2.0, {25.0, 20.0}, 5)) {
+  for (const test::PlaneStart& s : test::PerturbedStarts(scene, count, 0.2, 2.0, {25.0, 20.0}, 5)) {
     SeedFeature f;
     f.image = 0;
     f.uv = scene.cameras[0].Project(s.center);
@@ -243,6 +243,20 @@ TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
     f.candidates.push_back(c);
     seeds.push_back(f);
   }
+  return seeds;
+}
+
+// The points are reserved once, for as many as the reference cells can hold
+// (one per pixel, one per cell in pmvs mode), so that the waves append to
+// the array without copying it.
+TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
+  if (!UnwrittenMemoryIsFree()) {
+    GTEST_SKIP()
+        << "an address-space or data limit, or strict overcommit: the points are not reserved";
+  }
+  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
+  const MatchGroupData group = GroupWithGrey(scene);
+  const std::vector<SeedFeature> seeds = SeedsInImage0(scene, 6);
   const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
   for (const MatchMode mode : {MatchMode::kSapmvs, MatchMode::kPmvs}) {
     SCOPED_TRACE(mode == MatchMode::kPmvs ? "pmvs" : "sapmvs");
@@ -264,6 +278,66 @@ TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
     EXPECT_GT(propagator.points().size(), seeds.size());
     EXPECT_EQ(propagator.points().data(), array);
   }
+}
+
+// After GrowAsPmvs, Prune queues every point's rim and the waves grow as in
+// pmvs mode: from the adaptive patches' points into the cells beside them,
+// one-cell patches of window_size that emit their centres only; their
+// points lie on the true plane as the adaptive patches' do.
+TEST(Propagator, GrowsAsPmvsFromTheRimsOfTheAdaptivePatches) {
+  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
+  const MatchGroupData group = GroupWithGrey(scene);
+  const std::vector<SeedFeature> seeds = SeedsInImage0(scene, 4);
+  const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
+  MatcherOptions options;
+  options.max_angle_deg = 5.0;  // as above
+  options.max_waves = 1;        // so that the adaptive patches leave ground
+  PatchEngine engine(*kernels, group, options);
+  Propagator propagator(group, options, engine);
+  propagator.RunSeeds(seeds);
+  propagator.RunWaves({});
+  const size_t adaptive_points = propagator.points().size();
+  const size_t adaptive_patches = propagator.patches().size();
+  ASSERT_GT(adaptive_patches, 0u);
+  ASSERT_GT(adaptive_points, 2 * adaptive_patches);  // several points a patch
+
+  const MatcherOptions pmvs_options = PmvsPassOptions(options);
+  PatchEngine pmvs_engine(*kernels, group, pmvs_options);
+  propagator.GrowAsPmvs(pmvs_engine);
+  propagator.Prune(std::vector<bool>(adaptive_points, true));
+  ASSERT_EQ(propagator.points().size(), adaptive_points);
+  options.max_waves = 4;  // the propagator's options: three waves more
+  propagator.RunWaves({});
+  const std::vector<AcceptedPatch>& patches = propagator.patches();
+  const std::vector<DensePoint>& points = propagator.points();
+  ASSERT_GT(patches.size(), adaptive_patches);
+  std::vector<int> emitted(patches.size(), 0);
+  for (size_t i = adaptive_points; i < points.size(); ++i) {
+    const DensePoint& d = points[i];
+    ASSERT_GE(d.patch, static_cast<int>(adaptive_patches)) << "an adaptive patch emitted again";
+    ++emitted[d.patch];
+    const AcceptedPatch& patch = patches[d.patch];
+    EXPECT_EQ(patch.size, options.window_size);
+    EXPECT_LT((d.x - patch.center).norm(), 1e-9);
+    // Within a footprint (about 0.5 m here) of the ground, z = 0.
+    EXPECT_LT(std::abs(d.x.z()), 0.5) << "point " << i;
+  }
+  for (size_t p = adaptive_patches; p < patches.size(); ++p) EXPECT_EQ(emitted[p], 1) << p;
+  // The first of them lie beside the adaptive points: some reference cell
+  // of an adaptive point is a 4-neighbour of the first one-cell patch's.
+  const Camera& cam = scene.cameras[patches[adaptive_patches].ref];
+  const Eigen::Vector2d uv = cam.Project(patches[adaptive_patches].center);
+  const int cs = options.cell_size;
+  const int gx = static_cast<int>(std::floor((uv.x() + 0.5) / cs));
+  const int gy = static_cast<int>(std::floor((uv.y() + 0.5) / cs));
+  bool beside = false;
+  for (size_t i = 0; i < adaptive_points && !beside; ++i) {
+    if (patches[points[i].patch].ref != patches[adaptive_patches].ref) continue;
+    const int px = static_cast<int>(std::floor((points[i].uv.x() + 0.5) / cs));
+    const int py = static_cast<int>(std::floor((points[i].uv.y() + 0.5) / cs));
+    beside = std::abs(px - gx) + std::abs(py - gy) == 1;
+  }
+  EXPECT_TRUE(beside);
 }
 
 }  // namespace

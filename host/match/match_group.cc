@@ -33,9 +33,11 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-double DeviceSeconds(const PatchEngine& engine) {
+double DeviceSeconds(const std::vector<const PatchEngine*>& engines) {
   double s = 0;
-  for (const auto& [name, t] : engine.kernel_times()) s += t.seconds;
+  for (const PatchEngine* engine : engines) {
+    for (const auto& [name, t] : engine->kernel_times()) s += t.seconds;
+  }
   return s;
 }
 
@@ -130,11 +132,11 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   auto stage_start = std::chrono::steady_clock::now();
   double device_before = 0;
   double cpu_before = ProcessCpuSeconds();
-  const PatchEngine* engine_ptr = nullptr;
+  std::vector<const PatchEngine*> engines;  // those launched so far
   auto end_stage = [&](const std::string& name) {
     StageTime t;
     t.wall = Seconds(stage_start);
-    const double device_now = engine_ptr ? DeviceSeconds(*engine_ptr) : 0;
+    const double device_now = DeviceSeconds(engines);
     t.device = device_now - device_before;
     const double cpu_now = ProcessCpuSeconds();
     t.cpu = cpu_now - cpu_before;
@@ -194,7 +196,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   report("seeds", 0, 0, "building kernels");
   prepare.thread.join();
   PatchEngine engine(kernels, group, options);
-  engine_ptr = &engine;
+  engines.push_back(&engine);
   Propagator propagator(group, options, engine);
   propagator.RunSeeds(seeds, [&](long rank, long ranks, long accepted) {
     report("seeds", rank, ranks, std::to_string(accepted) + " accepted");
@@ -241,10 +243,26 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   const auto& points = propagator.points();
   const auto& patches = propagator.patches();
   std::vector<bool> keep;
+  // The engine of the passes that grow as PMVS does (pmvs_passes), made at
+  // the first of them.
+  const MatcherOptions pmvs_pass_options = PmvsPassOptions(options);
+  std::optional<PatchEngine> pmvs_pass_engine;
+  size_t pmvs_pass_first = 0;  // their first patch
   // PMVS's loop: expand, filter, and expand again into the ground the
   // filter freed; every pass filters all points, old and new.
   for (int pass = 0; pass < options.expand_iterations; ++pass) {
-    if (pass > 0) propagator.Prune(keep);
+    const bool as_pmvs = options.mode == MatchMode::kSapmvs &&
+                         pass >= options.expand_iterations - options.pmvs_passes;
+    if (as_pmvs && !pmvs_pass_engine) {
+      pmvs_pass_engine.emplace(kernels, group, pmvs_pass_options);
+      engines.push_back(&*pmvs_pass_engine);
+      pmvs_pass_first = patches.size();
+      propagator.GrowAsPmvs(*pmvs_pass_engine);
+      // Every pass PMVS's (pmvs_passes = expand_iterations): the seeds'
+      // rims, in place of their adaptive expansions.
+      if (pass == 0) keep.assign(points.size(), true);
+    }
+    if (pass > 0 || as_pmvs) propagator.Prune(keep);
     auto on_wave = [&](const std::string& what) {
       return [&, what](long wave, long size, long emitted) {
         report("propagation", pass + 1, options.expand_iterations,
@@ -252,12 +270,15 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                    std::to_string(emitted) + " points");
       };
     };
-    propagator.RunWaves(on_wave("wave"));
-    const long cut = propagator.RefitPlanes();
-    stats.removed_unfitted += cut;
-    if (cut > 0 && options.refill_cut) {
-      propagator.RunWaves(on_wave("refill wave"));
-      stats.removed_unfitted += propagator.RefitPlanes();
+    propagator.RunWaves(on_wave(as_pmvs ? "pmvs wave" : "wave"));
+    // One-cell patches emit their centres only: nothing to refit.
+    if (!as_pmvs) {
+      const long cut = propagator.RefitPlanes();
+      stats.removed_unfitted += cut;
+      if (cut > 0 && options.refill_cut) {
+        propagator.RunWaves(on_wave("refill wave"));
+        stats.removed_unfitted += propagator.RefitPlanes();
+      }
     }
     end_stage("propagation");
     report("filter", pass + 1, options.expand_iterations);
@@ -284,6 +305,9 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   stats.largest_wave = propagator.largest_wave();
   stats.points_before_filter = propagator.emitted();
   stats.patches = static_cast<long>(patches.size());
+  if (pmvs_pass_engine) {
+    stats.pmvs_pass_patches = static_cast<long>(patches.size() - pmvs_pass_first);
+  }
   for (const AcceptedPatch& p : patches) ++stats.accepted_by_size[p.size];
 
   PointCloud& cloud = result.cloud;
@@ -325,6 +349,12 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   }
   stats.points = static_cast<long>(cloud.points.size());
   stats.kernels = engine.kernel_times();
+  if (pmvs_pass_engine) {
+    // Under the same names: their launches are 7 x 7 scores and refinements.
+    for (const auto& [name, t] : pmvs_pass_engine->kernel_times()) {
+      AddKernelTime(t, &stats.kernels[name]);
+    }
+  }
   end_stage("output");
   if (own) own->Finish();
   return result;

@@ -22,6 +22,9 @@ std::string MatcherOptions::Problem() const {
   if (!(canny_low <= canny_high))
     return "canny_low <= canny_high (canny_low = " + OptionText(canny_low) +
            ", canny_high = " + OptionText(canny_high) + ")";
+  if (!(pmvs_passes <= expand_iterations))
+    return "pmvs_passes <= expand_iterations (pmvs_passes = " + OptionText(pmvs_passes) +
+           ", expand_iterations = " + OptionText(expand_iterations) + ")";
   // PMVS uses window_size alone and ignores the order of adaptive_sizes.
   if (mode == MatchMode::kSapmvs) {
     if (adaptive_sizes.empty() || adaptive_sizes.back() != window_size) {

@@ -85,6 +85,12 @@ NccScorerOptions ScoreOptionsOf(const MatcherOptions& options, int size) {
 
 }  // namespace
 
+MatcherOptions PmvsPassOptions(const MatcherOptions& options) {
+  MatcherOptions pmvs = options;
+  pmvs.mode = MatchMode::kPmvs;
+  return pmvs;
+}
+
 EngineKernels EngineKernelVariants(const MatcherOptions& options) {
   EngineKernels k;
   k.scorers.push_back(ScoreOptionsOf(options, options.window_size));
@@ -92,6 +98,11 @@ EngineKernels EngineKernelVariants(const MatcherOptions& options) {
   for (const auto& [size, polish] : PolishOptionsOf(options)) {
     k.scorers.push_back(ScoreOptionsOf(options, size));
     k.refiners.push_back(polish);
+  }
+  if (options.mode == MatchMode::kSapmvs && options.pmvs_passes > 0) {
+    const MatcherOptions pmvs = PmvsPassOptions(options);
+    k.scorers.push_back(ScoreOptionsOf(pmvs, pmvs.window_size));
+    k.refiners.push_back(RefineOptionsOf(pmvs));
   }
   return k;
 }

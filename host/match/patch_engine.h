@@ -69,12 +69,18 @@ WindowGrid SampledWindow(int side, int window_size, double max_step);
 
 // The kernel variants (one program each) an engine with these options
 // launches: the scores at window_size and at each larger adaptive size, the
-// refinement, and each size's polish.
+// refinement, and each size's polish; and in sapmvs mode with pmvs_passes
+// those of their engine (PmvsPassOptions).
 struct EngineKernels {
   std::vector<NccScorerOptions> scorers;
   std::vector<PatchRefinerOptions> refiners;
 };
 EngineKernels EngineKernelVariants(const MatcherOptions& options);
+
+// The options that evaluate the candidates of sapmvs mode's last passes
+// (MatcherOptions::pmvs_passes) as pmvs mode does: plain NCC at window_size,
+// no polish.
+MatcherOptions PmvsPassOptions(const MatcherOptions& options);
 
 class PatchEngine {
  public:

@@ -87,7 +87,7 @@ int Propagator::Grid::Index(const Eigen::Vector2d& uv, int cell) const {
 
 Propagator::Propagator(const MatchGroupData& group, const MatcherOptions& options,
                        PatchEngine& engine)
-    : group_(group), options_(options), engine_(engine) {
+    : group_(group), options_(options), engine_(&engine) {
   const int cs = options_.cell_size;
   for (const MatchImage& im : group_.images) {
     Grid g;
@@ -136,7 +136,7 @@ Propagator::EmitPlan Propagator::PlanEmit(const AcceptedPatch& patch) const {
   const Grid& grid = grids_[patch.ref];
   const int cs = options_.cell_size;
   const Eigen::Vector2d uv0 = cam.Project(patch.center);
-  if (options_.mode == MatchMode::kPmvs || patch.size <= 1) {
+  if (PmvsStyle() || patch.size <= 1) {
     DensePoint d;
     d.x = patch.center;
     d.uv = uv0.cast<float>();
@@ -212,37 +212,49 @@ bool Propagator::Emit(const AcceptedPatch& patch, const EmitPlan& plan) {
   return true;
 }
 
+void Propagator::Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
+                       std::vector<PatchCandidate>* front) {
+  const Camera& cam = group_.images[patch.ref].camera;
+  Grid& grid = grids_[patch.ref];
+  if (!cam.InImage(q, options_.window_size / 2 + 1)) return;
+  const int cell = grid.Index(q, options_.cell_size);
+  if (cell < 0 || grid.owner[cell] != -1 || grid.tries[cell] >= kMaxCellTries) return;
+  const Eigen::Vector3d c = IntersectPlane(cam, q, patch.center, patch.normal);
+  if (!c.allFinite()) return;
+  ++grid.tries[cell];
+  PatchCandidate cand;
+  cand.center = c;
+  cand.normal = patch.normal;
+  cand.ref = patch.ref;
+  cand.has_parent = true;
+  cand.parent_center = patch.center;
+  cand.parent_normal = patch.normal;
+  front->push_back(cand);
+}
+
+void Propagator::OfferBeside(const AcceptedPatch& patch, int cell,
+                             std::vector<PatchCandidate>* front) {
+  if (cell < 0) return;
+  const Grid& grid = grids_[patch.ref];
+  const int cs = options_.cell_size;
+  const int gx = cell % grid.cols, gy = cell / grid.cols;
+  for (int d = 0; d < 4; ++d) {
+    const int nx = gx + kDirections8[d][0], ny = gy + kDirections8[d][1];
+    Offer(patch, Eigen::Vector2d((nx + 0.5) * cs - 0.5, (ny + 0.5) * cs - 0.5), front);
+  }
+}
+
+void Propagator::GrowAsPmvs(PatchEngine& engine) {
+  engine_ = &engine;
+  grows_as_pmvs_ = true;
+}
+
 void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
   const AcceptedPatch& patch = patches_[patch_index];
   const Camera& cam = group_.images[patch.ref].camera;
-  Grid& grid = grids_[patch.ref];
-  const int cs = options_.cell_size;
-  const int hw = options_.window_size / 2;
   const Eigen::Vector2d uv0 = cam.Project(patch.center);
-  auto offer = [&](const Eigen::Vector2d& q) {
-    if (!cam.InImage(q, hw + 1)) return;
-    const int cell = grid.Index(q, cs);
-    if (cell < 0 || grid.owner[cell] != -1 || grid.tries[cell] >= kMaxCellTries) return;
-    const Eigen::Vector3d c = IntersectPlane(cam, q, patch.center, patch.normal);
-    if (!c.allFinite()) return;
-    ++grid.tries[cell];
-    PatchCandidate cand;
-    cand.center = c;
-    cand.normal = patch.normal;
-    cand.ref = patch.ref;
-    cand.has_parent = true;
-    cand.parent_center = patch.center;
-    cand.parent_normal = patch.normal;
-    front->push_back(cand);
-  };
-  if (options_.mode == MatchMode::kPmvs) {
-    const int cell = grid.Index(uv0, cs);
-    if (cell < 0) return;
-    const int gx = cell % grid.cols, gy = cell / grid.cols;
-    for (int d = 0; d < 4; ++d) {
-      const int nx = gx + kDirections8[d][0], ny = gy + kDirections8[d][1];
-      offer(Eigen::Vector2d((nx + 0.5) * cs - 0.5, (ny + 0.5) * cs - 0.5));
-    }
+  if (PmvsStyle()) {
+    OfferBeside(patch, grids_[patch.ref].Index(uv0, options_.cell_size), front);
   } else {
     // The paper's "just beyond its extent": the new centre two pixels past
     // the parent's edge, its window overlapping the parent's last pixels.
@@ -256,7 +268,7 @@ void Propagator::Expand(int patch_index, std::vector<PatchCandidate>* front) {
     const bool cut = options_.refill_cut && cut_[patch_index];
     const int step = (cut ? kUnfittedReach : patch.size / 2) + 2;
     const Eigen::Vector2d c(std::round(uv0.x()), std::round(uv0.y()));
-    for (const auto& d : kDirections8) offer(c + step * Eigen::Vector2d(d[0], d[1]));
+    for (const auto& d : kDirections8) Offer(patch, c + step * Eigen::Vector2d(d[0], d[1]), front);
   }
 }
 
@@ -305,7 +317,7 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
     for (size_t b = 0; b < batch.size(); b += options_.max_wave) {
       const size_t e = std::min(batch.size(), b + options_.max_wave);
       std::vector<PatchCandidate> part(batch.begin() + b, batch.begin() + e);
-      auto results = engine_.Evaluate(part);
+      auto results = engine_->Evaluate(part);
       for (const int i : AcceptBatch(results)) {
         done[which[b + i]] = 1;
         ++seeds_accepted_;
@@ -464,6 +476,15 @@ void Propagator::Prune(const std::vector<bool>& keep) {
     }
   }
   front_.clear();
+  if (grows_as_pmvs_) {
+    // Every point's rim: an adaptive patch's centre lies among its own
+    // points, whose cells it covers.
+    for (const DensePoint& d : points_) {
+      const AcceptedPatch& patch = patches_[d.patch];
+      OfferBeside(patch, grids_[patch.ref].Index(d.uv.cast<double>(), cs), &front_);
+    }
+    return;
+  }
   for (size_t p = 0; p < patches_.size(); ++p) {
     if (alive[p]) Expand(static_cast<int>(p), &front_);
   }
@@ -492,7 +513,7 @@ void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) 
     ++waves_;
     candidates_ += static_cast<long>(wave.size());
     largest_wave_ = std::max(largest_wave_, static_cast<long>(wave.size()));
-    auto results = engine_.Evaluate(wave);
+    auto results = engine_->Evaluate(wave);
     const size_t before = patches_.size();
     AcceptBatch(results);
     for (size_t p = before; p < patches_.size(); ++p) Expand(static_cast<int>(p), &front_);

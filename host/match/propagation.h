@@ -12,6 +12,8 @@
 //           are moved onto it, or cut back to its centre where none confirm it;
 //   pmvs:   a patch emits its centre and expands into the 4 neighbouring
 //           empty cells (PMVS's expansion in the patch plane).
+// sapmvs mode's last MatcherOptions::pmvs_passes passes grow as pmvs mode
+// does, from every point (GrowAsPmvs).
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
@@ -57,7 +59,8 @@ class Propagator {
   // Drops the points where keep[i] is false and frees their cells in every
   // grid, then queues the expansion of every patch that still has points
   // (PMVS's expand-filter iterations: the ground a false patch held is open
-  // to its neighbours' planes again). The freed cells may be tried again.
+  // to its neighbours' planes again), or after GrowAsPmvs every point's rim.
+  // The freed cells may be tried again.
   void Prune(const std::vector<bool>& keep);
   // sapmvs mode: fits each patch's plane to its neighbours' centres
   // (FitPatchNormals), moves its points onto the fitted plane, and keeps only
@@ -69,6 +72,13 @@ class Propagator {
   // Returns the points dropped. No-op in pmvs mode, whose patches emit their
   // centres only, and with refit_neighbours = 0.
   long RefitPlanes();
+  // From here on candidates are evaluated by `engine` and accepted patches
+  // emit and expand as in pmvs mode (MatcherOptions::pmvs_passes), and
+  // Prune queues, for every point, the empty cells beside its reference
+  // cell (4, as PMVS's), each a candidate on the point's patch plane: the
+  // rims of the adaptive patches, inside and out, where their centres'
+  // neighbouring cells are their own points'.
+  void GrowAsPmvs(PatchEngine& engine);
 
   const std::vector<AcceptedPatch>& patches() const { return patches_; }
   const std::vector<DensePoint>& points() const { return points_; }
@@ -102,6 +112,14 @@ class Propagator {
   // free; returns false (and stores nothing) when no cell was left for it.
   bool Emit(const AcceptedPatch& patch, const EmitPlan& plan);
   void Expand(int patch_index, std::vector<PatchCandidate>* front);
+  // Queues a candidate on `patch`'s plane at reference pixel q, unless q's
+  // cell is outside, covered or tried kMaxCellTries times.
+  void Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
+             std::vector<PatchCandidate>* front);
+  // Offer at the centres of the 4 cells beside reference cell `cell`.
+  void OfferBeside(const AcceptedPatch& patch, int cell, std::vector<PatchCandidate>* front);
+  // Patches emit and expand as in pmvs mode.
+  bool PmvsStyle() const { return grows_as_pmvs_ || options_.mode == MatchMode::kPmvs; }
   // Frees the cells point d owns, in its reference and its patch's views.
   void Release(const DensePoint& d);
   bool IsBarrier(int image, int x, int y, const AcceptedPatch& patch) const;
@@ -110,7 +128,8 @@ class Propagator {
 
   const MatchGroupData& group_;
   const MatcherOptions& options_;
-  PatchEngine& engine_;
+  PatchEngine* engine_;  // GrowAsPmvs replaces it
+  bool grows_as_pmvs_ = false;
   std::vector<Grid> grids_;
   std::vector<EdgeMap> edges_;
   std::vector<AcceptedPatch> patches_;

@@ -62,6 +62,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   sum->matched_edge_points += s.matched_edge_points;
   sum->candidates += s.candidates;
   sum->patches += s.patches;
+  sum->pmvs_pass_patches += s.pmvs_pass_patches;
   sum->waves += s.waves;
   sum->largest_wave = std::max(sum->largest_wave, s.largest_wave);
   for (const auto& [size, n] : s.accepted_by_size) sum->accepted_by_size[size] += n;
@@ -89,15 +90,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
       it->second.peak_rss_bytes = std::max(it->second.peak_rss_bytes, t.peak_rss_bytes);
     }
   }
-  for (const auto& [name, k] : s.kernels) {
-    KernelTime& d = sum->kernels[name];
-    d.launches += k.launches;
-    d.items += k.items;
-    d.ncc_evaluations += k.ncc_evaluations;
-    d.patch_size = k.patch_size;
-    d.seconds += k.seconds;
-    d.max_seconds = std::max(d.max_seconds, k.max_seconds);
-  }
+  for (const auto& [name, k] : s.kernels) AddKernelTime(k, &sum->kernels[name]);
   sum->gsd = s.gsd;
 }
 

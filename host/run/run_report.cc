@@ -36,7 +36,8 @@ nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   j["propagation"] = {{"waves", s.waves},
                       {"candidates", s.candidates},
                       {"largest_wave", s.largest_wave},
-                      {"patches", s.patches}};
+                      {"patches", s.patches},
+                      {"pmvs_pass_patches", s.pmvs_pass_patches}};
   nlohmann::json sizes = nlohmann::json::object();
   for (const auto& [size, count] : s.accepted_by_size) sizes[std::to_string(size)] = count;
   j["propagation"]["accepted_by_size"] = sizes;

@@ -2,6 +2,7 @@
 // What matching one group did and how long it took: counts, per-stage and
 // per-kernel times. The matcher fills them; the run sums, reports and
 // checkpoints them.
+#include <algorithm>
 #include <map>
 #include <string>
 #include <utility>
@@ -35,6 +36,16 @@ struct KernelTime {
   double max_seconds = 0;  // of one launch
 };
 
+// Adds t's launches to *sum (the same kernel, from another engine or group).
+inline void AddKernelTime(const KernelTime& t, KernelTime* sum) {
+  sum->launches += t.launches;
+  sum->items += t.items;
+  sum->ncc_evaluations += t.ncc_evaluations;
+  sum->patch_size = t.patch_size;
+  sum->seconds += t.seconds;
+  sum->max_seconds = std::max(sum->max_seconds, t.max_seconds);
+}
+
 struct MatchStats {
   int images = 0;
   long features = 0;
@@ -47,6 +58,7 @@ struct MatchStats {
   long waves = 0;
   long largest_wave = 0;
   std::map<int, long> accepted_by_size;  // sapmvs: patch side -> accepted patches
+  long pmvs_pass_patches = 0;            // sapmvs: of `patches`, pmvs_passes' (one cell each)
   long points_before_filter = 0;
   double score_floor = 0;      // the score fence's value (>= threshold)
   double plane_tolerance = 0;  // the neighbourhood test's, footprints (last pass)
