@@ -232,16 +232,26 @@ void Propagator::Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
   front->push_back(cand);
 }
 
-void Propagator::OfferBeside(const AcceptedPatch& patch, int cell,
-                             std::vector<PatchCandidate>* front) {
+void Propagator::Grid::Beside(int cell, std::vector<int>* out) const {
   if (cell < 0) return;
-  const Grid& grid = grids_[patch.ref];
-  const int cs = options_.cell_size;
-  const int gx = cell % grid.cols, gy = cell / grid.cols;
+  const int gx = cell % cols, gy = cell / cols;
   for (int d = 0; d < 4; ++d) {
     const int nx = gx + kDirections8[d][0], ny = gy + kDirections8[d][1];
-    Offer(patch, Eigen::Vector2d((nx + 0.5) * cs - 0.5, (ny + 0.5) * cs - 0.5), front);
+    if (nx >= 0 && ny >= 0 && nx < cols && ny < rows) out->push_back(ny * cols + nx);
   }
+}
+
+Eigen::Vector2d Propagator::Grid::Centre(int cell, int cs) const {
+  return Eigen::Vector2d((cell % cols + 0.5) * cs - 0.5, (cell / cols + 0.5) * cs - 0.5);
+}
+
+void Propagator::OfferBeside(const AcceptedPatch& patch, int cell,
+                             std::vector<PatchCandidate>* front) {
+  const Grid& grid = grids_[patch.ref];
+  std::vector<int>& beside = beside_scratch_;
+  beside.clear();
+  grid.Beside(cell, &beside);
+  for (const int next : beside) Offer(patch, grid.Centre(next, options_.cell_size), front);
 }
 
 void Propagator::GrowAsPmvs(PatchEngine& engine) {
@@ -478,10 +488,22 @@ void Propagator::Prune(const std::vector<bool>& keep) {
   front_.clear();
   if (grows_as_pmvs_) {
     // Every point's rim: an adaptive patch's centre lies among its own
-    // points, whose cells it covers.
-    for (const DensePoint& d : points_) {
-      const AcceptedPatch& patch = patches_[d.patch];
-      OfferBeside(patch, grids_[patch.ref].Index(d.uv.cast<double>(), cs), &front_);
+    // points, whose cells it covers. A patch offers each cell beside its
+    // points once (its points are stored together), not once per point
+    // beside it: up to four times the same candidate, and a second try
+    // (kMaxCellTries) spent on the same plane.
+    std::vector<int>& beside = beside_scratch_;  // the cells beside one patch's points
+    for (size_t i = 0; i < points_.size();) {
+      const int id = points_[i].patch;
+      const AcceptedPatch& patch = patches_[id];
+      const Grid& grid = grids_[patch.ref];
+      beside.clear();
+      for (; i < points_.size() && points_[i].patch == id; ++i) {
+        grid.Beside(grid.Index(points_[i].uv.cast<double>(), cs), &beside);
+      }
+      std::sort(beside.begin(), beside.end());
+      beside.erase(std::unique(beside.begin(), beside.end()), beside.end());
+      for (const int next : beside) Offer(patch, grid.Centre(next, cs), &front_);
     }
     return;
   }

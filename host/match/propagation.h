@@ -98,6 +98,10 @@ class Propagator {
     std::vector<int> owner;                                // patch index, -1 = empty
     std::vector<uint8_t> tries;                            // candidates started in the cell
     int Index(const Eigen::Vector2d& uv, int cell) const;  // -1 outside
+    // Appends the cells 4-connected to `cell` (none for -1) inside the grid.
+    void Beside(int cell, std::vector<int>* out) const;
+    // The pixel at the centre of `cell`, cs pixels a side.
+    Eigen::Vector2d Centre(int cell, int cs) const;
   };
   // What a patch would emit: its points (local frame, reference pixel), the
   // reference cell of each, and the cell each lands in in each of the
@@ -138,6 +142,8 @@ class Propagator {
   // cut_[p]: RefitPlanes cut patch p back to its centre (with refill_cut it
   // expands from there); one per patch, pushed with it.
   std::vector<uint8_t> cut_;
+  // Cells beside a patch's (OfferBeside, Prune), reused between patches.
+  std::vector<int> beside_scratch_;
   // Emit's flags of the planned points it kept, reused between patches.
   std::vector<uint8_t> emit_scratch_;
   std::vector<std::vector<double>> seed_depths_;
