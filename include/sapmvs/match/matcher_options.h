@@ -139,16 +139,14 @@ struct MatcherOptions {
   // sapmvs: the last this many of those passes grow as PMVS does: from every
   // kept point into the 4 empty cells beside its own, each candidate a patch
   // of one cell, scored with plain NCC at window_size (no polish, no colour
-  // weights), emitting its centre and not refit. They cover the rims and
+  // weights), emitting its centre and not refit. They cover the rims of the
   // holes the adaptive patches left, where a window straddled a depth edge
   // or the refit cut a patch back. One such pass in place of the third
   // adaptive one, against PMVS2's cloud of the same run (`versus_pmvs2
   // --pmvs2-cloud`): PMVS2's points covered within 2 GSD 69.4 -> 75.2 % on
-  // Herz-Jesu-P8 (its facade; its forecourt, which no view sees within
-  // view_angle_deg, 13.6 -> 14.7 %), 84.1 -> 85.5 % on `small`, 80.5 ->
-  // 82.3 % on `city`, at the same accuracy against the truth (within 1 GSD
-  // 97.7 -> 97.8 %, 93.7 -> 94.0 %; `campus` within 0.5 m 72.3 -> 72.2 %),
-  // for 0-26 % more time. 0 = every pass adaptive.
+  // Herz-Jesu-P8, 84.1 -> 85.5 % on `small`, 80.5 -> 82.4 % on `city`, at
+  // the same accuracy against the truth (within 1 GSD 97.7 -> 97.8 %,
+  // 93.7 -> 94.0 %), for 0-19 % more time. 0 = every pass adaptive.
   int pmvs_passes = 1;
   // Most candidate patches one device launch takes.
   int max_wave = 16384;
