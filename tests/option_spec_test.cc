@@ -160,6 +160,9 @@ TEST(OptionSpec, PmvsPassesAreAtMostThePasses) {
             "pmvs_passes <= expand_iterations (pmvs_passes = 3, expand_iterations = 2)");
   o.pmvs_passes = -1;
   EXPECT_NE(o.Problem().find("pmvs_passes"), std::string::npos) << o.Problem();
+  o = {};
+  o.pmvs_pass_view_angle_deg = 90;
+  EXPECT_NE(o.Problem().find("pmvs_pass_view_angle_deg"), std::string::npos) << o.Problem();
 }
 
 // `run` takes the flags of four structs: no flag may be described twice.
@@ -296,6 +299,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   EXPECT_EQ(defaults["refit_tolerance"], 0.7);
   EXPECT_FALSE(defaults.contains("refill_cut"));
   EXPECT_EQ(defaults["pmvs_passes"], 1);
+  EXPECT_EQ(defaults["pmvs_pass_view_angle_deg"], 80.0);
   MatcherOptions refill;
   refill.refill_cut = true;
   EXPECT_EQ(OptionsJson(refill)["refill_cut"], true);
@@ -304,6 +308,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   EXPECT_EQ(OptionsJson(pmvs)["mode"], "pmvs");
   // pmvs mode matches as before: its records resume.
   EXPECT_FALSE(OptionsJson(pmvs).contains("pmvs_passes"));
+  EXPECT_FALSE(OptionsJson(pmvs).contains("pmvs_pass_view_angle_deg"));
   // A later option is recorded once it is set, so that a run matched with
   // it does not resume under another value.
   MatcherOptions sparse = v1;

@@ -280,6 +280,20 @@ TEST(Propagator, ReservesItsPointsOnceForWhatTheCellsHold) {
   }
 }
 
+// The pmvs passes' candidates are evaluated as pmvs mode's, within their own
+// cone; everything else is the adaptive passes' options.
+TEST(PmvsPassOptions, ScoreAsPmvsModeWithinTheirOwnCone) {
+  MatcherOptions options;
+  options.pmvs_pass_view_angle_deg = 75;
+  options.threshold = 0.8;
+  const MatcherOptions pmvs = PmvsPassOptions(options);
+  EXPECT_EQ(pmvs.mode, MatchMode::kPmvs);
+  EXPECT_EQ(pmvs.view_angle_deg, 75);
+  EXPECT_EQ(pmvs.threshold, 0.8);
+  EXPECT_EQ(pmvs.window_size, options.window_size);
+  EXPECT_EQ(options.view_angle_deg, 60);
+}
+
 // After GrowAsPmvs, Prune queues every point's rim and the waves grow as in
 // pmvs mode: from the adaptive patches' points into the cells beside them,
 // one-cell patches of window_size that emit their centres only; their

@@ -88,6 +88,7 @@ NccScorerOptions ScoreOptionsOf(const MatcherOptions& options, int size) {
 MatcherOptions PmvsPassOptions(const MatcherOptions& options) {
   MatcherOptions pmvs = options;
   pmvs.mode = MatchMode::kPmvs;
+  pmvs.view_angle_deg = options.pmvs_pass_view_angle_deg;
   return pmvs;
 }
 

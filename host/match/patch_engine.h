@@ -79,7 +79,7 @@ EngineKernels EngineKernelVariants(const MatcherOptions& options);
 
 // The options that evaluate the candidates of sapmvs mode's last passes
 // (MatcherOptions::pmvs_passes) as pmvs mode does: plain NCC at window_size,
-// no polish.
+// no polish, within pmvs_pass_view_angle_deg.
 MatcherOptions PmvsPassOptions(const MatcherOptions& options);
 
 class PatchEngine {
