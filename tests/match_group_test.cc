@@ -468,6 +468,11 @@ TEST_F(MatchGroupTest, APmvsPassCoversMoreAtTheSameAccuracy) {
   EXPECT_GT(last.result.stats.pmvs_pass_patches, 0);
   EXPECT_GT(last.check.cells_covered, adaptive.check.cells_covered);
   EXPECT_GT(last.check.share_within, adaptive.check.share_within - 0.01);
+  // Their fence is their own: plain NCC over one 7 x 7 window scores below
+  // the adaptive patches' weighted NCC, right matches included.
+  EXPECT_EQ(adaptive.result.stats.pmvs_pass_score_floor, 0);
+  EXPECT_GE(last.result.stats.pmvs_pass_score_floor, o.threshold);
+  EXPECT_LT(last.result.stats.pmvs_pass_score_floor, last.result.stats.score_floor);
   // Their launches are counted with the others of the same size.
   EXPECT_GT(last.result.stats.kernels.at("patch_refine 7x7").items,
             adaptive.result.stats.kernels.at("patch_refine 7x7").items);

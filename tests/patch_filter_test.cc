@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -167,6 +168,31 @@ TEST(FilterPoints, PointsBelowTheScoreFloorGoAndAreCounted) {
   }
 }
 
+TEST(FilterPoints, OneCellPatchesMeetTheirOwnFloor) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  MatcherOptions options;
+  int weak = 0;
+  const Points p = GridWithWeakPatches(&weak);
+  // The second half of the patches as a pmvs pass's: they face 0.7, the
+  // first half 0.9.
+  ScoreFloors floors(0.9);
+  floors.one_cell_first = p.patches.size() / 2;
+  floors.one_cell = 0.7;
+  MatchStats stats;
+  const std::vector<bool> keep = FilterPoints(group, options, p.points, p.patches, &stats, floors);
+  long weak_before = 0;
+  for (size_t i = 0; i < keep.size(); ++i) {
+    const int patch = p.points[i].patch;
+    const bool one_cell = static_cast<size_t>(patch) >= floors.one_cell_first;
+    const bool low = p.patches[patch].score < 0.9f;
+    weak_before += low && !one_cell;
+    EXPECT_EQ(keep[i], one_cell || !low) << i;
+  }
+  EXPECT_GT(weak_before, 0);
+  EXPECT_LT(weak_before, weak) << "weak patches on both sides of one_cell_first";
+  EXPECT_EQ(stats.removed_score, weak_before);
+}
+
 TEST(FilterPoints, PointsBelowTheScoreFloorHideNothing) {
   const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
   MatcherOptions options;
@@ -301,16 +327,29 @@ TEST(SeedDepthFences, NearFenceIsTheSeedSearchsNearEndFarFenceIsTukeys) {
   }
 }
 
-TEST(ScoreFloor, ThresholdUnlessTheFenceLiesAboveIt) {
+// n points, each with a patch of its own scoring score(i), and options with
+// a fence 2 robust SDs wide above a 0.7 threshold.
+struct Scored {
   MatcherOptions options;
-  options.threshold = 0.7;
-  options.score_fence = 2.0;
-  std::vector<AcceptedPatch> patches(20);
-  std::vector<DensePoint> points(20);
-  for (int i = 0; i < 20; ++i) {
-    patches[i].score = 0.95f + 0.001f * static_cast<float>(i % 5);
-    points[i].patch = i;
+  std::vector<AcceptedPatch> patches;
+  std::vector<DensePoint> points;
+};
+Scored ScoredPoints(int n, const std::function<float(int)>& score) {
+  Scored s;
+  s.options.threshold = 0.7;
+  s.options.score_fence = 2.0;
+  s.patches.resize(n);
+  s.points.resize(n);
+  for (int i = 0; i < n; ++i) {
+    s.patches[i].score = score(i);
+    s.points[i].patch = i;
   }
+  return s;
+}
+
+TEST(ScoreFloor, ThresholdUnlessTheFenceLiesAboveIt) {
+  auto [options, patches, points] =
+      ScoredPoints(20, [](int i) { return 0.95f + 0.001f * static_cast<float>(i % 5); });
   const double tight = ScoreFloor(options, points, patches);
   EXPECT_GT(tight, 0.9) << "scores within 0.004 of each other: the fence lies well above 0.7";
   for (int i = 0; i < 10; ++i) patches[i].score = 0.3f + 0.06f * static_cast<float>(i);
@@ -319,6 +358,19 @@ TEST(ScoreFloor, ThresholdUnlessTheFenceLiesAboveIt) {
   options.score_fence = 0;
   points.resize(5);
   EXPECT_DOUBLE_EQ(ScoreFloor(options, points, patches), options.threshold);
+}
+
+TEST(ScoreFloor, OfThePatchesFromFirstPatchOn) {
+  // The first 20 tight near 0.98, the last 20 tight near 0.90.
+  const auto [options, patches, points] = ScoredPoints(
+      40, [](int i) { return (i < 20 ? 0.98f : 0.90f) + 0.001f * static_cast<float>(i % 5); });
+  const double all = ScoreFloor(options, points, patches);
+  const double later = ScoreFloor(options, points, patches, 20);
+  EXPECT_GT(later, 0.89);
+  EXPECT_LT(later, 0.90) << "the later patches' own fence";
+  EXPECT_LT(all, later) << "both groups together spread the scores";
+  EXPECT_DOUBLE_EQ(ScoreFloor(options, points, patches, 35), options.threshold)
+      << "fewer than 10 points: the threshold";
 }
 
 }  // namespace

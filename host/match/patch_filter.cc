@@ -193,11 +193,11 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
-                               double score_floor) {
+                               const ScoreFloors& floors) {
   std::vector<bool> eligible(points.size());
   long low = 0;
   for (size_t i = 0; i < points.size(); ++i) {
-    eligible[i] = patches[points[i].patch].score >= score_floor;
+    eligible[i] = patches[points[i].patch].score >= floors.Of(points[i].patch);
     low += !eligible[i];
   }
   stats->removed_score = low;
@@ -367,11 +367,15 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
 }
 
 double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
-                  const std::vector<AcceptedPatch>& patches) {
+                  const std::vector<AcceptedPatch>& patches, size_t first_patch) {
   double floor = options.threshold;
-  if (options.score_fence > 0 && points.size() >= 10) {
-    std::vector<double> s;
-    for (const DensePoint& d : points) s.push_back(patches[d.patch].score);
+  std::vector<double> s;
+  if (options.score_fence > 0) {
+    for (const DensePoint& d : points) {
+      if (static_cast<size_t>(d.patch) >= first_patch) s.push_back(patches[d.patch].score);
+    }
+  }
+  if (s.size() >= 10) {
     std::nth_element(s.begin(), s.begin() + s.size() / 2, s.end());
     const double median = s[s.size() / 2];
     for (double& v : s) v = std::abs(v - median);

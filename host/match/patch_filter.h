@@ -19,6 +19,8 @@
 //     plane_tolerance footprints;
 //  3. clusters: points linked within neighbour_radius footprints form
 //     clusters; those smaller than min_cluster_size go.
+#include <cstddef>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -29,20 +31,37 @@
 
 namespace sapmvs {
 
+// The score fences of a group's patches: `floor` for the patches before
+// `one_cell_first`, `one_cell` from it on (sapmvs mode's pmvs passes, whose
+// one-cell patches score plain NCC over one window_size window: on
+// `small` their right matches score a median 0.92 where the adaptive
+// patches' weighted NCC scores 0.985, so the adaptive patches' fence cut
+// most of them, walls and all).
+struct ScoreFloors {
+  ScoreFloors(double all = 0) : floor(all), one_cell(all) {}  // NOLINT: one floor for all
+  double floor = 0;
+  size_t one_cell_first = std::numeric_limits<size_t>::max();
+  double one_cell = 0;
+  double Of(int patch) const {
+    return static_cast<size_t>(patch) >= one_cell_first ? one_cell : floor;
+  }
+};
+
 // keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
-// filled. Points of patches scoring below `score_floor` go first
+// filled. Points of patches scoring below their floor (`floors`) go first
 // (removed_score) and take no part in the other passes.
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
-                               double score_floor = 0);
+                               const ScoreFloors& floors = ScoreFloors());
 
-// The score floor of `points` (their patches' scores): `options.threshold`,
-// raised to median - score_fence robust standard deviations (1.4826 MAD)
-// when score_fence > 0 and there are at least 10 points. Taken from the first
-// expansion's points, it keeps the weakest matches of a block out.
+// The score floor of the points of patches `first_patch` on (their
+// patches' scores): `options.threshold`, raised to median - score_fence
+// robust standard deviations (1.4826 MAD) when score_fence > 0 and there are
+// at least 10 such points. Taken from the first expansion's points, it keeps
+// the weakest matches of a block out.
 double ScoreFloor(const MatcherOptions& options, const std::vector<DensePoint>& points,
-                  const std::vector<AcceptedPatch>& patches);
+                  const std::vector<AcceptedPatch>& patches, size_t first_patch = 0);
 
 // Per image, the depths a point may lie at in it as its reference. Beyond
 // the seeds: Tukey's far fence on the image's seed depths (3 interquartile

@@ -70,6 +70,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   // A run's floor and tolerance: the highest of its groups' (each group has
   // its own).
   sum->score_floor = std::max(sum->score_floor, s.score_floor);
+  sum->pmvs_pass_score_floor = std::max(sum->pmvs_pass_score_floor, s.pmvs_pass_score_floor);
   sum->removed_score += s.removed_score;
   sum->plane_tolerance = std::max(sum->plane_tolerance, s.plane_tolerance);
   sum->removed_visibility += s.removed_visibility;

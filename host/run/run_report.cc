@@ -43,6 +43,7 @@ nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
   j["propagation"]["accepted_by_size"] = sizes;
   j["filter"] = {{"points_before", s.points_before_filter},
                  {"score_floor", s.score_floor},
+                 {"pmvs_pass_score_floor", s.pmvs_pass_score_floor},
                  {"plane_tolerance", s.plane_tolerance},
                  {"removed_score", s.removed_score},
                  {"removed_visibility", s.removed_visibility},

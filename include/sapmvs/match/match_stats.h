@@ -60,9 +60,10 @@ struct MatchStats {
   std::map<int, long> accepted_by_size;  // sapmvs: patch side -> accepted patches
   long pmvs_pass_patches = 0;            // sapmvs: of `patches`, pmvs_passes' (one cell each)
   long points_before_filter = 0;
-  double score_floor = 0;      // the score fence's value (>= threshold)
-  double plane_tolerance = 0;  // the neighbourhood test's, footprints (last pass)
-  long removed_score = 0;      // below score_floor
+  double score_floor = 0;            // the score fence's value (>= threshold)
+  double pmvs_pass_score_floor = 0;  // sapmvs: the fence of pmvs_passes' one-cell patches
+  double plane_tolerance = 0;        // the neighbourhood test's, footprints (last pass)
+  long removed_score = 0;            // below score_floor
   long removed_visibility = 0;
   long removed_neighbourhood = 0;
   long removed_clusters = 0;
