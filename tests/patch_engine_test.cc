@@ -383,6 +383,30 @@ TEST_F(PatchEngineTest, NarrowViewsTakePartWhenSomePairIsWideEnough) {
   EXPECT_EQ(accepted, 8);
 }
 
+// A pmvs pass's one-cell patch needs a view at least 2 max_angle from its
+// reference, where a patch of pmvs mode needs some pair of its images beyond
+// max_angle: image 0's views are 4 and 8 degrees from it.
+TEST_F(PatchEngineTest, OneCellPassPatchesNeedAViewTwiceMaxAngleFromTheReference) {
+  const double base = 40.0 * std::tan(4.0 * kPiRad / 180.0);
+  const PlaneScene strip = MakePlaneScene(5, 201, 161, 96, base);
+  MatchGroupData group = test::MatchGroupOf(strip);
+  for (MatchImage& im : group.images) im.depth = 40.0;
+  MatcherOptions sapmvs;
+  SelectViews(sapmvs, &group);
+  auto accepted = [&](const MatcherOptions& options, PatchEngine::Role role) {
+    PatchEngine engine(NewKernels(), group, options, role);
+    int n = 0;
+    for (const auto& r : engine.Evaluate(TiltedSeeds(strip, 8, 0.0, 0.0, 99))) n += r.has_value();
+    return n;
+  };
+  MatcherOptions pass = PmvsPassOptions(sapmvs);
+  ASSERT_EQ(pass.max_angle_deg, 10.0);
+  EXPECT_EQ(accepted(pass, PatchEngine::Role::kPatches), 8);
+  EXPECT_EQ(accepted(pass, PatchEngine::Role::kOneCellPass), 0);
+  pass.max_angle_deg = 3.0;
+  EXPECT_EQ(accepted(pass, PatchEngine::Role::kOneCellPass), 8);
+}
+
 // A large window keeps its extent and loses samples: the fewest odd grid
 // whose spacing stays at most the step asked for; the window size itself and
 // anything smaller sample every pixel.

@@ -175,15 +175,15 @@ TEST(FilterPoints, OneCellPatchesMeetTheirOwnFloor) {
   const Points p = GridWithWeakPatches(&weak);
   // The second half of the patches as a pmvs pass's: they face 0.7, the
   // first half 0.9.
-  ScoreFloors floors(0.9);
-  floors.one_cell_first = p.patches.size() / 2;
-  floors.one_cell = 0.7;
+  PatchClasses classes(0.9);
+  classes.one_cell_first = p.patches.size() / 2;
+  classes.one_cell_floor = 0.7;
   MatchStats stats;
-  const std::vector<bool> keep = FilterPoints(group, options, p.points, p.patches, &stats, floors);
+  const std::vector<bool> keep = FilterPoints(group, options, p.points, p.patches, &stats, classes);
   long weak_before = 0;
   for (size_t i = 0; i < keep.size(); ++i) {
     const int patch = p.points[i].patch;
-    const bool one_cell = static_cast<size_t>(patch) >= floors.one_cell_first;
+    const bool one_cell = classes.OneCell(patch);
     const bool low = p.patches[patch].score < 0.9f;
     weak_before += low && !one_cell;
     EXPECT_EQ(keep[i], one_cell || !low) << i;
@@ -191,6 +191,40 @@ TEST(FilterPoints, OneCellPatchesMeetTheirOwnFloor) {
   EXPECT_GT(weak_before, 0);
   EXPECT_LT(weak_before, weak) << "weak patches on both sides of one_cell_first";
   EXPECT_EQ(stats.removed_score, weak_before);
+}
+
+// Points on the ground whose patches' planes tilt 60 degrees, as a one-cell
+// patch's may where its window straddles a roof edge: the patch-support test
+// drops them, unless they are a pmvs pass's one-cell patches.
+TEST(FilterPoints, OneCellPatchesPlanesAreNotJudgedByTheirNeighbours) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  MatcherOptions options;
+  int weak = 0;
+  Points p = GridWithWeakPatches(&weak);
+  for (AcceptedPatch& patch : p.patches) patch.score = 0.97f;
+  const int first_tilted = static_cast<int>(p.patches.size());
+  for (int i = 0; i < 10; ++i) {
+    const int k = p.Add(Eigen::Vector3d(-4.35 + 0.9 * i, 0.15, 0), 0, {1, 2}, 0.97f);
+    // Tilted towards the grid's diagonal: of the 16 grid points around a
+    // cell's centre, 4 lie on its plane.
+    const double t = std::sin(M_PI / 3) / std::sqrt(2.0);
+    p.patches[p.points[k].patch].normal = Eigen::Vector3d(t, t, std::cos(M_PI / 3));
+  }
+  MatchStats adaptive_stats;
+  const std::vector<bool> adaptive =
+      FilterPoints(group, options, p.points, p.patches, &adaptive_stats);
+  PatchClasses classes;
+  classes.one_cell_first = static_cast<size_t>(first_tilted);
+  MatchStats one_cell_stats;
+  const std::vector<bool> one_cell =
+      FilterPoints(group, options, p.points, p.patches, &one_cell_stats, classes);
+  for (size_t i = 0; i < p.points.size(); ++i) {
+    const bool tilted = p.points[i].patch >= first_tilted;
+    EXPECT_EQ(adaptive[i], !tilted) << i;
+    EXPECT_TRUE(one_cell[i]) << i;
+  }
+  EXPECT_EQ(adaptive_stats.removed_neighbourhood, 10);
+  EXPECT_EQ(one_cell_stats.removed_neighbourhood, 0);
 }
 
 TEST(FilterPoints, PointsBelowTheScoreFloorHideNothing) {

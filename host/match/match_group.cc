@@ -249,14 +249,14 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   const MatcherOptions pmvs_pass_options = PmvsPassOptions(options);
   std::optional<PatchEngine> pmvs_pass_engine;
   size_t pmvs_pass_first = 0;  // their first patch
-  ScoreFloors floors;
+  PatchClasses classes;
   // PMVS's loop: expand, filter, and expand again into the ground the
   // filter freed; every pass filters all points, old and new.
   for (int pass = 0; pass < options.expand_iterations; ++pass) {
     const bool as_pmvs = options.mode == MatchMode::kSapmvs &&
                          pass >= options.expand_iterations - options.pmvs_passes;
     if (as_pmvs && !pmvs_pass_engine) {
-      pmvs_pass_engine.emplace(kernels, group, pmvs_pass_options);
+      pmvs_pass_engine.emplace(kernels, group, pmvs_pass_options, PatchEngine::Role::kOneCellPass);
       engines.push_back(&*pmvs_pass_engine);
       pmvs_pass_first = patches.size();
       propagator.GrowAsPmvs(*pmvs_pass_engine);
@@ -289,19 +289,19 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     // pmvs passes' one-cell patches score on another scale, so theirs comes
     // from their own first pass.
     if (pass == 0) stats.score_floor = ScoreFloor(options, points, patches);
-    if (as_pmvs && floors.one_cell_first == std::numeric_limits<size_t>::max()) {
-      floors.one_cell_first = pmvs_pass_first;
-      floors.one_cell = ScoreFloor(options, points, patches, pmvs_pass_first);
-      stats.pmvs_pass_score_floor = floors.one_cell;
+    if (as_pmvs && classes.one_cell_first == std::numeric_limits<size_t>::max()) {
+      classes.one_cell_first = pmvs_pass_first;
+      classes.one_cell_floor = ScoreFloor(options, points, patches, pmvs_pass_first);
+      stats.pmvs_pass_score_floor = classes.one_cell_floor;
     }
-    floors.floor = stats.score_floor;
+    classes.floor = stats.score_floor;
     // The filter's neighbour table makes each pass's peak, which is the
     // group's. The waves' threads freed many small blocks (emit plans, flood
     // fills, batches) that glibc keeps in their arenas and in the heap's
     // holes: on `city` 10-12 MiB of that peak, handed back here.
     ReleaseFreeMemory();
     MatchStats removed;
-    keep = FilterPoints(group, options, points, patches, &removed, floors);
+    keep = FilterPoints(group, options, points, patches, &removed, classes);
     stats.removed_depth_range += ApplyDepthFences(group, points, patches, plausible, &keep);
     stats.removed_score += removed.removed_score;
     stats.plane_tolerance = removed.plane_tolerance;

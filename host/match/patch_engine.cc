@@ -109,10 +109,11 @@ EngineKernels EngineKernelVariants(const MatcherOptions& options) {
 }
 
 PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
-                         const MatcherOptions& options)
+                         const MatcherOptions& options, Role role)
     : kernels_(kernels),
       group_(group),
       options_(options),
+      role_(role),
       refine_options_(RefineOptionsOf(options)),
       polish_options_(PolishOptionsOf(options)) {
   kernels_.SetGroup(group_.ncc);
@@ -435,7 +436,10 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::EvaluateBatch(
         sum += r.view_scores[v];
       }
     }
-    if (static_cast<int>(a.views.size()) < need || !WideEnough(a.center, a.ref, a.views)) continue;
+    if (static_cast<int>(a.views.size()) < need ||
+        !WideEnough(a.center, a.ref, a.views, /*from_ref=*/role_ == Role::kOneCellPass)) {
+      continue;
+    }
     a.score = static_cast<float>(sum / a.views.size());
     a.size = options_.window_size;
     results[refine_of[k]] = std::move(a);

@@ -193,11 +193,11 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
-                               const ScoreFloors& floors) {
+                               const PatchClasses& classes) {
   std::vector<bool> eligible(points.size());
   long low = 0;
   for (size_t i = 0; i < points.size(); ++i) {
-    eligible[i] = patches[points[i].patch].score >= floors.Of(points[i].patch);
+    eligible[i] = patches[points[i].patch].score >= classes.FloorOf(points[i].patch);
     low += !eligible[i];
   }
   stats->removed_score = low;
@@ -303,6 +303,14 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // all pass test 2 among themselves however wrong the plane is; its
   // neighbours are the independent evidence. A majority is asked for, not
   // all, so a roof patch survives ground neighbours along its edge.
+  // Not a pmvs pass's one-cell patch: it emits its centre only, which test
+  // 2 judges, and its plane is what a window_size window cannot pin down
+  // where it straddles an edge. A wall of `small` is under 7 pixels wide in
+  // a nadir image within 21 degrees of the nadir, and PMVS2's points on it
+  // come from patches whose normals lie a median 45 degrees off the wall's:
+  // this test dropped ours (77 % of PMVS2's right points that ours missed
+  // lay on walls). Their depth is pinned instead by a view at least 2
+  // max_angle_deg from their reference (PatchEngine::Role::kOneCellPass).
   std::vector<int> foreign(patches.size(), 0), consistent(patches.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
@@ -321,6 +329,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     consistent[id] += c;
   }
   auto supported = [&](int id) {
+    if (classes.OneCell(id)) return true;
     return foreign[id] >= options.min_neighbours && 2 * consistent[id] >= foreign[id];
   };
   long removed_plane = 0;

@@ -14,7 +14,8 @@
 //  2. neighbourhood: a point needs min_neighbours points within
 //     neighbour_radius footprints and must lie within the plane tolerance of
 //     the plane they fit, and a patch's plane must pass within it of most
-//     points of other patches around it. The tolerance is plane_sigmas robust
+//     points of other patches around it (not a one-cell patch's, see
+//     FilterPoints). The tolerance is plane_sigmas robust
 //     standard deviations of those patch-to-patch distances, at least
 //     plane_tolerance footprints;
 //  3. clusters: points linked within neighbour_radius footprints form
@@ -31,29 +32,29 @@
 
 namespace sapmvs {
 
-// The score fences of a group's patches: `floor` for the patches before
-// `one_cell_first`, `one_cell` from it on (sapmvs mode's pmvs passes, whose
-// one-cell patches score plain NCC over one window_size window: on
-// `small` their right matches score a median 0.92 where the adaptive
-// patches' weighted NCC scores 0.985, so the adaptive patches' fence cut
-// most of them, walls and all).
-struct ScoreFloors {
-  ScoreFloors(double all = 0) : floor(all), one_cell(all) {}  // NOLINT: one floor for all
+// How the filter tells a group's patches apart: sapmvs mode's pmvs passes'
+// one-cell patches are those from `one_cell_first` on (none by default).
+// Their points meet their own score floor: they score plain NCC over one
+// window_size window, on another scale than the adaptive patches' weighted
+// NCC (on `small` medians 0.92 and 0.985), and the adaptive patches' fence
+// cut most of them, walls and all. And the patch-support test does not
+// judge their planes (FilterPoints).
+struct PatchClasses {
+  PatchClasses(double all = 0) : floor(all), one_cell_floor(all) {}  // NOLINT: one floor for all
   double floor = 0;
   size_t one_cell_first = std::numeric_limits<size_t>::max();
-  double one_cell = 0;
-  double Of(int patch) const {
-    return static_cast<size_t>(patch) >= one_cell_first ? one_cell : floor;
-  }
+  double one_cell_floor = 0;
+  bool OneCell(int patch) const { return static_cast<size_t>(patch) >= one_cell_first; }
+  double FloorOf(int patch) const { return OneCell(patch) ? one_cell_floor : floor; }
 };
 
 // keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
-// filled. Points of patches scoring below their floor (`floors`) go first
+// filled. Points of patches scoring below their floor (`classes`) go first
 // (removed_score) and take no part in the other passes.
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
-                               const ScoreFloors& floors = ScoreFloors());
+                               const PatchClasses& classes = PatchClasses());
 
 // The score floor of the points of patches `first_patch` on (their
 // patches' scores): `options.threshold`, raised to median - score_fence
