@@ -63,7 +63,7 @@ struct MatchStats {
   double score_floor = 0;            // the score fence's value (>= threshold)
   double pmvs_pass_score_floor = 0;  // sapmvs: the fence of pmvs_passes' one-cell patches
   double plane_tolerance = 0;        // the neighbourhood test's, footprints (last pass)
-  long removed_score = 0;            // below score_floor
+  long removed_score = 0;            // below their floor (score_floor, pmvs_pass_score_floor)
   long removed_visibility = 0;
   long removed_neighbourhood = 0;
   long removed_clusters = 0;
