@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
-#include <limits>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -248,17 +247,17 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   // the first of them.
   const MatcherOptions pmvs_pass_options = PmvsPassOptions(options);
   std::optional<PatchEngine> pmvs_pass_engine;
-  size_t pmvs_pass_first = 0;  // their first patch
-  PatchClasses classes;
+  PatchClasses classes;  // their patches from classes.one_cell_first on
   // PMVS's loop: expand, filter, and expand again into the ground the
   // filter freed; every pass filters all points, old and new.
   for (int pass = 0; pass < options.expand_iterations; ++pass) {
     const bool as_pmvs = options.mode == MatchMode::kSapmvs &&
                          pass >= options.expand_iterations - options.pmvs_passes;
-    if (as_pmvs && !pmvs_pass_engine) {
+    const bool first_pmvs_pass = as_pmvs && !pmvs_pass_engine;
+    if (first_pmvs_pass) {
       pmvs_pass_engine.emplace(kernels, group, pmvs_pass_options, PatchEngine::Role::kOneCellPass);
       engines.push_back(&*pmvs_pass_engine);
-      pmvs_pass_first = patches.size();
+      classes.one_cell_first = patches.size();
       propagator.GrowAsPmvs(*pmvs_pass_engine);
       // Every pass PMVS's (pmvs_passes = expand_iterations): the seeds'
       // rims, in place of their adaptive expansions.
@@ -289,9 +288,8 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     // pmvs passes' one-cell patches score on another scale, so theirs comes
     // from their own first pass.
     if (pass == 0) stats.score_floor = ScoreFloor(options, points, patches);
-    if (as_pmvs && classes.one_cell_first == std::numeric_limits<size_t>::max()) {
-      classes.one_cell_first = pmvs_pass_first;
-      classes.one_cell_floor = ScoreFloor(options, points, patches, pmvs_pass_first);
+    if (first_pmvs_pass) {
+      classes.one_cell_floor = ScoreFloor(options, points, patches, classes.one_cell_first);
       stats.pmvs_pass_score_floor = classes.one_cell_floor;
     }
     classes.floor = stats.score_floor;
@@ -316,7 +314,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   stats.points_before_filter = propagator.emitted();
   stats.patches = static_cast<long>(patches.size());
   if (pmvs_pass_engine) {
-    stats.pmvs_pass_patches = static_cast<long>(patches.size() - pmvs_pass_first);
+    stats.pmvs_pass_patches = static_cast<long>(patches.size() - classes.one_cell_first);
   }
   for (const AcceptedPatch& p : patches) ++stats.accepted_by_size[p.size];
 
