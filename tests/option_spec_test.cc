@@ -163,6 +163,11 @@ TEST(OptionSpec, PmvsPassesAreAtMostThePasses) {
   o = {};
   o.pmvs_pass_view_angle_deg = 90;
   EXPECT_NE(o.Problem().find("pmvs_pass_view_angle_deg"), std::string::npos) << o.Problem();
+  o = {};
+  o.pmvs_pass_plane_tolerance = -0.5;
+  EXPECT_NE(o.Problem().find("pmvs_pass_plane_tolerance"), std::string::npos) << o.Problem();
+  o.pmvs_pass_plane_tolerance = 0;
+  EXPECT_EQ(o.Problem(), "");
 }
 
 // `run` takes the flags of four structs: no flag may be described twice.
@@ -300,6 +305,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   EXPECT_FALSE(defaults.contains("refill_cut"));
   EXPECT_EQ(defaults["pmvs_passes"], 1);
   EXPECT_EQ(defaults["pmvs_pass_view_angle_deg"], 80.0);
+  EXPECT_EQ(defaults["pmvs_pass_plane_tolerance"], 2.0);
   MatcherOptions refill;
   refill.refill_cut = true;
   EXPECT_EQ(OptionsJson(refill)["refill_cut"], true);
@@ -309,6 +315,7 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   // pmvs mode matches as before: its records resume.
   EXPECT_FALSE(OptionsJson(pmvs).contains("pmvs_passes"));
   EXPECT_FALSE(OptionsJson(pmvs).contains("pmvs_pass_view_angle_deg"));
+  EXPECT_FALSE(OptionsJson(pmvs).contains("pmvs_pass_plane_tolerance"));
   // A later option is recorded once it is set, so that a run matched with
   // it does not resume under another value.
   MatcherOptions sparse = v1;

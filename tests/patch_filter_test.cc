@@ -227,6 +227,81 @@ TEST(FilterPoints, OneCellPatchesPlanesAreNotJudgedByTheirNeighbours) {
   EXPECT_EQ(one_cell_stats.removed_neighbourhood, 0);
 }
 
+// A pixel of disparity in a view 60 m off a nadir reference at 100 m (31
+// degrees between the rays) moves a ground point 1.94 footprints in depth,
+// in one 10 m off (5.7 degrees) 10.0 footprints.
+TEST(DisparityDepth, IsTheViewsFootprintOverTheSineOfTheirAngle) {
+  const MatchGroupData group = NadirGroup({{0, 0, 100}, {60, 0, 100}, {10, 0, 100}, {0, 0, 50}});
+  Points p;
+  const int k = p.Add(Eigen::Vector3d(0, 0, 0), 0, {1, 2}, 0.9f);
+  const AcceptedPatch& patch = p.patches[p.points[k].patch];
+  EXPECT_NEAR(DisparityDepth(group, patch), std::sqrt(60.0 * 60 + 100 * 100) / 60, 1e-9);
+  AcceptedPatch narrow = patch;
+  narrow.views = {2};
+  EXPECT_NEAR(DisparityDepth(group, narrow), std::sqrt(10.0 * 10 + 100 * 100) / 10, 1e-9);
+  // A view on the reference's ray resolves nothing; a view at half the
+  // reference's distance has half its footprint.
+  AcceptedPatch none = patch;
+  none.views = {3};
+  EXPECT_TRUE(std::isinf(DisparityDepth(group, none)));
+  none.views.clear();
+  EXPECT_TRUE(std::isinf(DisparityDepth(group, none)));
+  AcceptedPatch nearer = patch;
+  nearer.ref = 3;
+  nearer.views = {1};
+  const double sine = 60 / std::sqrt(60.0 * 60 + 100 * 100);
+  EXPECT_NEAR(DisparityDepth(group, nearer), 2.0 / sine, 1e-9);
+}
+
+// One-cell patches 1.5 footprints (0.5 m) above a flat grid, beyond its
+// 0.5-footprint plane tolerance: the neighbourhood test keeps those whose
+// views resolve their depth to within pmvs_pass_plane_tolerance (a view 60 m
+// off, 1.94 footprints), not those seen from 10 m off (10 footprints), nor
+// adaptive patches there, nor any at pmvs_pass_plane_tolerance 0.
+TEST(FilterPoints, OneCellPatchesResolvedByTheirViewsMeetTheirOwnPlaneTolerance) {
+  const MatchGroupData group =
+      NadirGroup({{0, 0, 100}, {60, 0, 100}, {-60, 0, 100}, {10, 0, 100}, {-10, 0, 100}});
+  int weak = 0;
+  Points p = GridWithWeakPatches(&weak);
+  for (AcceptedPatch& patch : p.patches) patch.score = 0.97f;
+  const int first_raised = static_cast<int>(p.patches.size());
+  std::vector<int> wide, narrow;
+  for (int i = 0; i < 6; ++i) {
+    const Eigen::Vector3d x(-4.35 + 1.8 * i, -2.85, 0.5);
+    wide.push_back(p.Add(x, 0, {1, 2}, 0.97f));
+    narrow.push_back(p.Add(x + Eigen::Vector3d(0, 5.4, 0), 0, {3, 4}, 0.97f));
+  }
+  MatcherOptions options;
+  ASSERT_EQ(options.pmvs_pass_plane_tolerance, 2.0);
+  PatchClasses classes;
+  classes.one_cell_first = static_cast<size_t>(first_raised);
+  auto run = [&](const PatchClasses& c, MatchStats* stats) {
+    return FilterPoints(group, options, p.points, p.patches, stats, c);
+  };
+  MatchStats one_cell_stats, adaptive_stats, off_stats;
+  const std::vector<bool> one_cell = run(classes, &one_cell_stats);
+  const std::vector<bool> adaptive = run(PatchClasses(), &adaptive_stats);
+  EXPECT_DOUBLE_EQ(one_cell_stats.plane_tolerance, 0.5);
+  for (const int k : wide) {
+    EXPECT_TRUE(one_cell[k]) << k;
+    EXPECT_FALSE(adaptive[k]) << k;
+  }
+  for (const int k : narrow) {
+    EXPECT_FALSE(one_cell[k]) << k;
+    EXPECT_FALSE(adaptive[k]) << k;
+  }
+  EXPECT_EQ(one_cell_stats.removed_neighbourhood, 6);
+  EXPECT_EQ(adaptive_stats.removed_neighbourhood, 12);
+  options.pmvs_pass_plane_tolerance = 0;
+  const std::vector<bool> off = run(classes, &off_stats);
+  for (const int k : wide) EXPECT_FALSE(off[k]) << k;
+  EXPECT_EQ(off_stats.removed_neighbourhood, 12);
+  // The grid itself stays whole throughout.
+  for (int k = 0; k < first_raised; ++k) {
+    EXPECT_TRUE(one_cell[k] && adaptive[k] && off[k]) << k;
+  }
+}
+
 TEST(FilterPoints, PointsBelowTheScoreFloorHideNothing) {
   const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
   MatcherOptions options;

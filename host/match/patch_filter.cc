@@ -190,6 +190,19 @@ std::vector<bool> VisibilityFilter(const MatchGroupData& group, const MatcherOpt
   return std::vector<bool>(kept.begin(), kept.end());
 }
 
+double DisparityDepth(const MatchGroupData& group, const AcceptedPatch& patch) {
+  const Eigen::Vector3d& x = patch.center;
+  const Camera& ref = group.images[patch.ref].camera;
+  const Eigen::Vector3d ray = (ref.center() - x).normalized();
+  double best = std::numeric_limits<double>::infinity();
+  for (const int v : patch.views) {
+    const Camera& view = group.images[v].camera;
+    const double sine = ray.cross((view.center() - x).normalized()).norm();
+    if (sine > 0) best = std::min(best, Footprint(view, x) / sine);
+  }
+  return best / Footprint(ref, x);
+}
+
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
@@ -265,7 +278,10 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   if (!std::isnan(median)) tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * median);
   stats->plane_tolerance = tolerance;
 
-  // 2. Neighbourhood and local plane.
+  // 2. Neighbourhood and local plane. A pmvs pass's one-cell patch whose
+  // views resolve its depth to within pmvs_pass_plane_tolerance may lie that
+  // far off the plane (MatcherOptions::pmvs_pass_plane_tolerance).
+  const double one_cell_tolerance = std::max(tolerance, options.pmvs_pass_plane_tolerance);
   std::vector<uint8_t> pass(alive.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
@@ -296,7 +312,12 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
     es.computeDirect(cov);
     const Eigen::Vector3d normal = es.eigenvectors().col(0);
-    pass[a] = std::abs(normal.dot(p.x - mean)) <= tolerance * fp;
+    double within = tolerance;
+    if (classes.OneCell(p.patch) && options.pmvs_pass_plane_tolerance > tolerance &&
+        DisparityDepth(group, patches[p.patch]) <= options.pmvs_pass_plane_tolerance) {
+      within = one_cell_tolerance;
+    }
+    pass[a] = std::abs(normal.dot(p.x - mean)) <= within * fp;
   }
   // 2b. Patch support: the points of other patches next to a patch must lie
   // on its plane. A sapmvs patch emits hundreds of points on one plane, which

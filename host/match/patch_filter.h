@@ -17,7 +17,9 @@
 //     points of other patches around it (not a one-cell patch's, see
 //     FilterPoints). The tolerance is plane_sigmas robust
 //     standard deviations of those patch-to-patch distances, at least
-//     plane_tolerance footprints;
+//     plane_tolerance footprints; for a pmvs pass's one-cell patch whose
+//     depth its views resolve to within pmvs_pass_plane_tolerance footprints
+//     (DisparityDepth), at least that;
 //  3. clusters: points linked within neighbour_radius footprints form
 //     clusters; those smaller than min_cluster_size go.
 #include <cstddef>
@@ -47,6 +49,12 @@ struct PatchClasses {
   bool OneCell(int patch) const { return static_cast<size_t>(patch) >= one_cell_first; }
   double FloorOf(int patch) const { return OneCell(patch) ? one_cell_floor : floor; }
 };
+
+// The depth, in footprints of its reference at its centre, by which a pixel
+// of disparity in the best placed of its views moves a patch's centre along
+// its reference's ray: the least over its views of the view's footprint over
+// the sine of the angle between the two rays (infinity without views).
+double DisparityDepth(const MatchGroupData& group, const AcceptedPatch& patch);
 
 // keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
 // filled. Points of patches scoring below their floor (`classes`) go first
