@@ -281,7 +281,6 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // 2. Neighbourhood and local plane. A pmvs pass's one-cell patch whose
   // views resolve its depth to within pmvs_pass_plane_tolerance may lie that
   // far off the plane (MatcherOptions::pmvs_pass_plane_tolerance).
-  const double one_cell_tolerance = std::max(tolerance, options.pmvs_pass_plane_tolerance);
   std::vector<uint8_t> pass(alive.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
@@ -315,7 +314,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     double within = tolerance;
     if (classes.OneCell(p.patch) && options.pmvs_pass_plane_tolerance > tolerance &&
         DisparityDepth(group, patches[p.patch]) <= options.pmvs_pass_plane_tolerance) {
-      within = one_cell_tolerance;
+      within = options.pmvs_pass_plane_tolerance;
     }
     pass[a] = std::abs(normal.dot(p.x - mean)) <= within * fp;
   }
