@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <random>
 #include <set>
@@ -352,6 +353,50 @@ TEST(Propagator, GrowsAsPmvsFromTheRimsOfTheAdaptivePatches) {
     beside = std::abs(px - gx) + std::abs(py - gy) == 1;
   }
   EXPECT_TRUE(beside);
+}
+
+// A pmvs pass also offers each patch's rims in its views, with the view as
+// reference (Propagator::OfferInViews): the adaptive patches grown from
+// seeds in image 0 alone leave one-cell patches in images 1 and 2 too;
+// none where those images are view-only (another strip's), or where they
+// meet image 0 at less than 2 max_angle_deg (here 2.9 degrees: 2 m apart at
+// 40 m).
+TEST(Propagator, APmvsPassGrowsFromItsRimsInItsViewsToo) {
+  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17, 2.0);
+  const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
+  auto one_cell_refs = [&](double max_angle_deg, bool views_reference) {
+    MatchGroupData group = GroupWithGrey(scene);
+    for (size_t i = 1; i < group.images.size(); ++i) group.images[i].reference = views_reference;
+    MatcherOptions options;
+    options.max_angle_deg = max_angle_deg;
+    options.max_waves = 1;
+    PatchEngine engine(*kernels, group, options);
+    Propagator propagator(group, options, engine);
+    propagator.RunSeeds(SeedsInImage0(scene, 4));
+    propagator.RunWaves({});
+    const size_t adaptive_points = propagator.points().size();
+    const size_t adaptive_patches = propagator.patches().size();
+    EXPECT_GT(adaptive_patches, 0u);
+    for (const AcceptedPatch& p : propagator.patches()) EXPECT_EQ(p.ref, 0);
+    const MatcherOptions pmvs_options = PmvsPassOptions(options);  // the engine keeps a reference
+    PatchEngine pmvs_engine(*kernels, group, pmvs_options);
+    propagator.GrowAsPmvs(pmvs_engine);
+    propagator.Prune(std::vector<bool>(adaptive_points, true));
+    options.max_waves = 3;  // the propagator's options: two waves more
+    propagator.RunWaves({});
+    std::map<int, int> refs;
+    const std::vector<AcceptedPatch>& patches = propagator.patches();
+    for (size_t p = adaptive_patches; p < patches.size(); ++p) ++refs[patches[p].ref];
+    return refs;
+  };
+  const std::map<int, int> wide = one_cell_refs(1.0, true);
+  std::printf("[ measured ] one-cell patches by reference: 0: %d, 1: %d, 2: %d\n",
+              wide.count(0) ? wide.at(0) : 0, wide.count(1) ? wide.at(1) : 0,
+              wide.count(2) ? wide.at(2) : 0);
+  EXPECT_GT(wide.count(0), 0u);
+  EXPECT_TRUE(wide.count(1) || wide.count(2));
+  for (const auto& [ref, n] : one_cell_refs(1.0, false)) EXPECT_EQ(ref, 0) << n;
+  for (const auto& [ref, n] : one_cell_refs(2.0, true)) EXPECT_EQ(ref, 0) << n;
 }
 
 }  // namespace

@@ -213,9 +213,10 @@ bool Propagator::Emit(const AcceptedPatch& patch, const EmitPlan& plan) {
 }
 
 void Propagator::Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
-                       std::vector<PatchCandidate>* front) {
-  const Camera& cam = group_.images[patch.ref].camera;
-  Grid& grid = grids_[patch.ref];
+                       std::vector<PatchCandidate>* front, int image) {
+  if (image < 0) image = patch.ref;
+  const Camera& cam = group_.images[image].camera;
+  Grid& grid = grids_[image];
   if (!cam.InImage(q, options_.window_size / 2 + 1)) return;
   const int cell = grid.Index(q, options_.cell_size);
   if (cell < 0 || grid.owner[cell] != -1 || grid.tries[cell] >= kMaxCellTries) return;
@@ -225,7 +226,7 @@ void Propagator::Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
   PatchCandidate cand;
   cand.center = c;
   cand.normal = patch.normal;
-  cand.ref = patch.ref;
+  cand.ref = image;
   cand.has_parent = true;
   cand.parent_center = patch.center;
   cand.parent_normal = patch.normal;
@@ -252,6 +253,31 @@ void Propagator::OfferBeside(const AcceptedPatch& patch, int cell,
   beside.clear();
   grid.Beside(cell, &beside);
   for (const int next : beside) Offer(patch, grid.Centre(next, options_.cell_size), front);
+}
+
+void Propagator::OfferInViews(const AcceptedPatch& patch, const std::vector<Eigen::Vector3d>& xs,
+                              std::vector<PatchCandidate>* front) {
+  const int cs = options_.cell_size;
+  const Eigen::Vector3d& ref_center = group_.images[patch.ref].camera.center();
+  std::vector<int>& beside = beside_scratch_;
+  for (const int v : patch.views) {
+    const MatchImage& view = group_.images[v];
+    // A view-only image (another strip's) takes no patch as reference; a
+    // view near the reference's ray sees the same rim.
+    if (!view.reference) continue;
+    if (TriangulationAngleDeg(ref_center, view.camera.center(), patch.center) <
+        2 * options_.max_angle_deg) {
+      continue;
+    }
+    const Grid& grid = grids_[v];
+    beside.clear();
+    for (const Eigen::Vector3d& x : xs) {
+      if (view.camera.Depth(x) > 0) grid.Beside(grid.Index(view.camera.Project(x), cs), &beside);
+    }
+    std::sort(beside.begin(), beside.end());
+    beside.erase(std::unique(beside.begin(), beside.end()), beside.end());
+    for (const int next : beside) Offer(patch, grid.Centre(next, cs), front, v);
+  }
 }
 
 void Propagator::GrowAsPmvs(PatchEngine& engine) {
@@ -491,19 +517,27 @@ void Propagator::Prune(const std::vector<bool>& keep) {
     // points, whose cells it covers. A patch offers each cell beside its
     // points once (its points are stored together), not once per point
     // beside it: up to four times the same candidate, and a second try
-    // (kMaxCellTries) spent on the same plane.
+    // (kMaxCellTries) spent on the same plane. Then the rims in its views
+    // (OfferInViews); the waves grow in each new patch's own reference. In
+    // the views at every wave as well, Herz-Jesu-P8 took 21 % longer than
+    // with the rims alone (49.1 against 40.6 s), for 2.5 points more of
+    // PMVS2's points covered and 1.6 points fewer of ours near them.
     std::vector<int>& beside = beside_scratch_;  // the cells beside one patch's points
+    std::vector<Eigen::Vector3d>& xs = rim_scratch_;
     for (size_t i = 0; i < points_.size();) {
       const int id = points_[i].patch;
       const AcceptedPatch& patch = patches_[id];
       const Grid& grid = grids_[patch.ref];
       beside.clear();
+      xs.clear();
       for (; i < points_.size() && points_[i].patch == id; ++i) {
         grid.Beside(grid.Index(points_[i].uv.cast<double>(), cs), &beside);
+        xs.push_back(points_[i].x);
       }
       std::sort(beside.begin(), beside.end());
       beside.erase(std::unique(beside.begin(), beside.end()), beside.end());
       for (const int next : beside) Offer(patch, grid.Centre(next, cs), &front_);
+      OfferInViews(patch, xs, &front_);
     }
     return;
   }

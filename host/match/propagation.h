@@ -116,12 +116,21 @@ class Propagator {
   // free; returns false (and stores nothing) when no cell was left for it.
   bool Emit(const AcceptedPatch& patch, const EmitPlan& plan);
   void Expand(int patch_index, std::vector<PatchCandidate>* front);
-  // Queues a candidate on `patch`'s plane at reference pixel q, unless q's
+  // Queues a candidate on `patch`'s plane at pixel q of `image` (its
+  // reference by default), with that image as its reference, unless q's
   // cell is outside, covered or tried kMaxCellTries times.
   void Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
-             std::vector<PatchCandidate>* front);
+             std::vector<PatchCandidate>* front, int image = -1);
   // Offer at the centres of the 4 cells beside reference cell `cell`.
   void OfferBeside(const AcceptedPatch& patch, int cell, std::vector<PatchCandidate>* front);
+  // A pmvs pass's rim in the patch's views: Offer at the cells beside the
+  // projections of points `xs` (the patch's) in each view that may be a
+  // reference and meets the reference at `patch.center` at 2 max_angle_deg
+  // or more, with that view as reference. PMVS2 expands a patch in every
+  // image it is seen in: a wall a few pixels wide in a nadir reference is
+  // wider in the oblique view beside it.
+  void OfferInViews(const AcceptedPatch& patch, const std::vector<Eigen::Vector3d>& xs,
+                    std::vector<PatchCandidate>* front);
   // Patches emit and expand as in pmvs mode.
   bool PmvsStyle() const { return grows_as_pmvs_ || options_.mode == MatchMode::kPmvs; }
   // Frees the cells point d owns, in its reference and its patch's views.
@@ -144,6 +153,8 @@ class Propagator {
   std::vector<uint8_t> cut_;
   // Cells beside a patch's (OfferBeside, Prune), reused between patches.
   std::vector<int> beside_scratch_;
+  // A patch's points (Prune's rims in the views), reused between patches.
+  std::vector<Eigen::Vector3d> rim_scratch_;
   // Emit's flags of the planned points it kept, reused between patches.
   std::vector<uint8_t> emit_scratch_;
   std::vector<std::vector<double>> seed_depths_;
