@@ -152,7 +152,7 @@ struct MatcherOptions {
   // covers walls: 87.4 -> 90.4 % on `small`, 83.8 -> 87.5 % on `city`.
   // Their rims are offered in the patches' wide views too, as PMVS2 expands
   // in every image a patch is seen in (Propagator::OfferInViews): 92.3 ->
-  // 93.4 %, 89.6 -> 90.1 %, Herz-Jesu-P8 82.4 -> 84.0 %, for 8-13 % more
+  // 93.4 %, 89.6 -> 90.1 %, Herz-Jesu-P8 82.4 -> 84.0 %, for 8-14 % more
   // time. 0 = every pass adaptive.
   int pmvs_passes = 1;
   // sapmvs: view_angle_deg for those passes' one-cell patches. A patch's
