@@ -123,13 +123,17 @@ class Propagator {
              std::vector<PatchCandidate>* front, int image = -1);
   // Offer at the centres of the 4 cells beside reference cell `cell`.
   void OfferBeside(const AcceptedPatch& patch, int cell, std::vector<PatchCandidate>* front);
+  // Offer in `image` at the centres of its grid's `cells`, each once
+  // (`cells` is sorted and deduplicated in place).
+  void OfferAtCells(const AcceptedPatch& patch, int image, std::vector<int>* cells,
+                    std::vector<PatchCandidate>* front);
   // A pmvs pass's rim in the patch's views: Offer at the cells beside the
-  // projections of points `xs` (the patch's) in each view that may be a
-  // reference and meets the reference at `patch.center` at 2 max_angle_deg
-  // or more, with that view as reference. PMVS2 expands a patch in every
-  // image it is seen in: a wall a few pixels wide in a nadir reference is
-  // wider in the oblique view beside it.
-  void OfferInViews(const AcceptedPatch& patch, const std::vector<Eigen::Vector3d>& xs,
+  // projections of points_[first, last) (the patch's) in each view that may
+  // be a reference and meets the reference at `patch.center` at 2
+  // max_angle_deg or more, with that view as reference. PMVS2 expands a
+  // patch in every image it is seen in: a wall a few pixels wide in a nadir
+  // reference is wider in the oblique view beside it.
+  void OfferInViews(const AcceptedPatch& patch, size_t first, size_t last,
                     std::vector<PatchCandidate>* front);
   // Patches emit and expand as in pmvs mode.
   bool PmvsStyle() const { return grows_as_pmvs_ || options_.mode == MatchMode::kPmvs; }
@@ -153,8 +157,6 @@ class Propagator {
   std::vector<uint8_t> cut_;
   // Cells beside a patch's (OfferBeside, Prune), reused between patches.
   std::vector<int> beside_scratch_;
-  // A patch's points (Prune's rims in the views), reused between patches.
-  std::vector<Eigen::Vector3d> rim_scratch_;
   // Emit's flags of the planned points it kept, reused between patches.
   std::vector<uint8_t> emit_scratch_;
   std::vector<std::vector<double>> seed_depths_;
