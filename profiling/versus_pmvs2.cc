@@ -177,6 +177,16 @@ void WritePyramidShiftedFolder(const fs::path& pmvs, int level, const fs::path& 
   }
 }
 
+// A folder for a second PMVS2 run on the same input: its images, matrices
+// and option file linked or copied, its own models/.
+void WriteRepeatFolder(const fs::path& input, const fs::path& dir) {
+  fs::remove_all(dir);
+  fs::create_directories(dir / "models");
+  fs::create_directory_symlink(fs::absolute(input / "visualize"), dir / "visualize");
+  fs::create_directory_symlink(fs::absolute(input / "txt"), dir / "txt");
+  fs::copy_file(input / "option", dir / "option");
+}
+
 // Takes the surface prior out of an exported folder's side file (see the
 // top of this file).
 // Returns the folder's offset to world (zero for a folder without a side
@@ -307,6 +317,10 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--run-flags", run_flags,
                  "More flags for each `sapmvs run`, in one argument (\"--refill-cut --no-edges\")");
+  bool again = false;
+  app.add_flag("--pmvs2-again", again,
+               "Run PMVS2 a second time (OUT/pmvs2_again) and compare its cloud with the first's "
+               "as a row of its own: how far PMVS2 agrees with itself");
   bool shift_pyramid = false;
   app.add_flag("--shift-pmvs2-pyramid", shift_pyramid,
                "Give PMVS2 matrices shifted by (2^level - 1)/2 px, undoing its pyramid's offset "
@@ -315,6 +329,9 @@ int main(int argc, char** argv) {
   try {
     if (level < 0 || threads < 1 || max_images < 0) {
       throw Error("expected --level >= 0, --threads >= 1, --max-images >= 0");
+    }
+    if (again && !pmvs2_cloud.empty()) {
+      throw Error("expected --pmvs2-again without --pmvs2-cloud (it runs PMVS2 twice itself)");
     }
     const fs::path build = BuildDir();
     const fs::path sapmvs = sapmvs_path.empty() ? build / "sapmvs" : fs::path(sapmvs_path);
@@ -376,6 +393,21 @@ int main(int argc, char** argv) {
       r.cloud = ReadPly(input / "models" / "option.ply");
       Translate(&r.cloud, origin);
       rows.push_back(std::move(r));
+      // Its threads take the patches in whatever order they finish, so two
+      // runs on the same input differ: the second one's row is how much of
+      // PMVS2's cloud PMVS2 itself covers, the scale of the other rows'.
+      if (again) {
+        const fs::path repeat = out / "pmvs2_again";
+        WriteRepeatFolder(input, repeat);
+        Row second;
+        second.name = rows.back().name + ", second run";
+        second.usage =
+            Step({{pmvs2.string(), repeat.string() + "/", "option"}, {}, logs / "pmvs2_again.log"},
+                 &commands);
+        second.cloud = ReadPly(repeat / "models" / "option.ply");
+        Translate(&second.cloud, origin);
+        rows.push_back(std::move(second));
+      }
     }
     for (const std::string& mode : modes) {
       const fs::path run = out / ("run_" + mode);
