@@ -355,48 +355,80 @@ TEST(Propagator, GrowsAsPmvsFromTheRimsOfTheAdaptivePatches) {
   EXPECT_TRUE(beside);
 }
 
+// The references of the one-cell patches a pmvs pass grows in two waves
+// from the adaptive patches of seeds in image 0 (one wave), on a strip of
+// three images 2 m apart at 40 m (2.9 degrees). Images 1 and 2 may be
+// references while the pass's first rims are offered (Prune) and in its
+// waves, or not.
+std::map<int, int> PmvsPassRefs(test::PlaneScene& scene, PatchKernels& kernels,
+                                double max_angle_deg, bool views_reference_at_start,
+                                bool views_reference_in_waves) {
+  MatchGroupData group = GroupWithGrey(scene);
+  auto views_reference = [&](bool reference) {
+    for (size_t i = 1; i < group.images.size(); ++i) group.images[i].reference = reference;
+  };
+  views_reference(views_reference_at_start);
+  MatcherOptions options;
+  options.max_angle_deg = max_angle_deg;
+  options.max_waves = 1;
+  PatchEngine engine(kernels, group, options);
+  Propagator propagator(group, options, engine);
+  propagator.RunSeeds(SeedsInImage0(scene, 4));
+  propagator.RunWaves({});
+  const size_t adaptive_points = propagator.points().size();
+  const size_t adaptive_patches = propagator.patches().size();
+  EXPECT_GT(adaptive_patches, 0u);
+  for (const AcceptedPatch& p : propagator.patches()) EXPECT_EQ(p.ref, 0);
+  const MatcherOptions pmvs_options = PmvsPassOptions(options);  // the engine keeps a reference
+  PatchEngine pmvs_engine(kernels, group, pmvs_options);
+  propagator.GrowAsPmvs(pmvs_engine);
+  propagator.Prune(std::vector<bool>(adaptive_points, true));
+  views_reference(views_reference_in_waves);
+  options.max_waves = 3;  // the propagator's options: two waves more
+  propagator.RunWaves({});
+  std::map<int, int> refs;
+  const std::vector<AcceptedPatch>& patches = propagator.patches();
+  for (size_t p = adaptive_patches; p < patches.size(); ++p) ++refs[patches[p].ref];
+  std::printf("[ measured ] one-cell patches by reference: 0: %d, 1: %d, 2: %d\n",
+              refs.count(0) ? refs.at(0) : 0, refs.count(1) ? refs.at(1) : 0,
+              refs.count(2) ? refs.at(2) : 0);
+  return refs;
+}
+
 // A pmvs pass also offers each patch's rims in its views, with the view as
 // reference (Propagator::OfferInViews): the adaptive patches grown from
 // seeds in image 0 alone leave one-cell patches in images 1 and 2 too;
 // none where those images are view-only (another strip's), or where they
-// meet image 0 at less than 2 max_angle_deg (here 2.9 degrees: 2 m apart at
-// 40 m).
+// meet image 0 at less than 2 max_angle_deg.
 TEST(Propagator, APmvsPassGrowsFromItsRimsInItsViewsToo) {
   test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17, 2.0);
   const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
-  auto one_cell_refs = [&](double max_angle_deg, bool views_reference) {
-    MatchGroupData group = GroupWithGrey(scene);
-    for (size_t i = 1; i < group.images.size(); ++i) group.images[i].reference = views_reference;
-    MatcherOptions options;
-    options.max_angle_deg = max_angle_deg;
-    options.max_waves = 1;
-    PatchEngine engine(*kernels, group, options);
-    Propagator propagator(group, options, engine);
-    propagator.RunSeeds(SeedsInImage0(scene, 4));
-    propagator.RunWaves({});
-    const size_t adaptive_points = propagator.points().size();
-    const size_t adaptive_patches = propagator.patches().size();
-    EXPECT_GT(adaptive_patches, 0u);
-    for (const AcceptedPatch& p : propagator.patches()) EXPECT_EQ(p.ref, 0);
-    const MatcherOptions pmvs_options = PmvsPassOptions(options);  // the engine keeps a reference
-    PatchEngine pmvs_engine(*kernels, group, pmvs_options);
-    propagator.GrowAsPmvs(pmvs_engine);
-    propagator.Prune(std::vector<bool>(adaptive_points, true));
-    options.max_waves = 3;  // the propagator's options: two waves more
-    propagator.RunWaves({});
-    std::map<int, int> refs;
-    const std::vector<AcceptedPatch>& patches = propagator.patches();
-    for (size_t p = adaptive_patches; p < patches.size(); ++p) ++refs[patches[p].ref];
-    return refs;
-  };
-  const std::map<int, int> wide = one_cell_refs(1.0, true);
-  std::printf("[ measured ] one-cell patches by reference: 0: %d, 1: %d, 2: %d\n",
-              wide.count(0) ? wide.at(0) : 0, wide.count(1) ? wide.at(1) : 0,
-              wide.count(2) ? wide.at(2) : 0);
+  const std::map<int, int> wide = PmvsPassRefs(scene, *kernels, 1.0, true, true);
   EXPECT_GT(wide.count(0), 0u);
   EXPECT_TRUE(wide.count(1) || wide.count(2));
-  for (const auto& [ref, n] : one_cell_refs(1.0, false)) EXPECT_EQ(ref, 0) << n;
-  for (const auto& [ref, n] : one_cell_refs(2.0, true)) EXPECT_EQ(ref, 0) << n;
+  for (const auto& [ref, n] : PmvsPassRefs(scene, *kernels, 1.0, false, false)) {
+    EXPECT_EQ(ref, 0) << n;
+  }
+  for (const auto& [ref, n] : PmvsPassRefs(scene, *kernels, 2.0, true, true)) {
+    EXPECT_EQ(ref, 0) << n;
+  }
+}
+
+// ... and each new patch's rims in its views at every wave (Expand), as
+// PMVS2 expands a patch in every image it is seen in. With images 1 and 2
+// references only once the pass's first rims are offered (in image 0
+// alone), their one-cell patches can only come from the waves' rims in the
+// views. Still none where the views meet image 0 at less than 2
+// max_angle_deg.
+TEST(Propagator, APmvsPassGrowsInItsViewsAtEveryWave) {
+  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17, 2.0);
+  const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
+  const std::map<int, int> wide = PmvsPassRefs(scene, *kernels, 1.0, false, true);
+  EXPECT_GT(wide.count(0), 0u);
+  EXPECT_TRUE(wide.count(1) || wide.count(2));
+  for (const auto& [ref, n] : PmvsPassRefs(scene, *kernels, 2.0, false, true)) {
+    EXPECT_EQ(ref, 0) << n;
+  }
 }
 
 }  // namespace

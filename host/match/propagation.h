@@ -128,12 +128,12 @@ class Propagator {
   void OfferAtCells(const AcceptedPatch& patch, int image, std::vector<int>* cells,
                     std::vector<PatchCandidate>* front);
   // A pmvs pass's rim in the patch's views: Offer at the cells beside the
-  // projections of points_[first, last) (the patch's) in each view that may
-  // be a reference and meets the reference at `patch.center` at 2
-  // max_angle_deg or more, with that view as reference. PMVS2 expands a
-  // patch in every image it is seen in: a wall a few pixels wide in a nadir
-  // reference is wider in the oblique view beside it.
-  void OfferInViews(const AcceptedPatch& patch, size_t first, size_t last,
+  // projections of its points [first, last) in each view that may be a
+  // reference and meets the reference at `patch.center` at 2 max_angle_deg
+  // or more, with that view as reference. PMVS2 expands a patch in every
+  // image it is seen in: a wall a few pixels wide in a nadir reference is
+  // wider in the oblique view beside it.
+  void OfferInViews(const AcceptedPatch& patch, const DensePoint* first, const DensePoint* last,
                     std::vector<PatchCandidate>* front);
   // Patches emit and expand as in pmvs mode.
   bool PmvsStyle() const { return grows_as_pmvs_ || options_.mode == MatchMode::kPmvs; }
