@@ -177,14 +177,21 @@ void WritePyramidShiftedFolder(const fs::path& pmvs, int level, const fs::path& 
   }
 }
 
-// A folder for a second PMVS2 run on the same input: its images, matrices
-// and option file linked or copied, its own models/.
+// A folder for a second PMVS2 run on the same input: everything PMVS2 reads
+// (images, matrices, a vis.dat where there is one) linked, the option file
+// copied, and models/ its own.
 void WriteRepeatFolder(const fs::path& input, const fs::path& dir) {
   fs::remove_all(dir);
   fs::create_directories(dir / "models");
-  fs::create_directory_symlink(fs::absolute(input / "visualize"), dir / "visualize");
-  fs::create_directory_symlink(fs::absolute(input / "txt"), dir / "txt");
-  fs::copy_file(input / "option", dir / "option");
+  for (const fs::directory_entry& e : fs::directory_iterator(input)) {
+    const fs::path name = e.path().filename();
+    if (name == "models") continue;
+    if (name == "option") {
+      fs::copy_file(e.path(), dir / name);
+    } else {
+      fs::create_symlink(fs::absolute(e.path()), dir / name);
+    }
+  }
 }
 
 // Takes the surface prior out of an exported folder's side file (see the
