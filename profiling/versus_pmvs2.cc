@@ -392,28 +392,25 @@ int main(int argc, char** argv) {
       }
       fs::create_directories(input / "models");
       fs::remove(input / "models" / "option.ply");
-      Row r;
-      r.name = shift_pyramid ? "PMVS2, P shifted for its pyramid" : "PMVS2";
-      // PMVS2 joins the prefix and its file names as strings.
-      r.usage = Step({{pmvs2.string(), input.string() + "/", "option"}, {}, logs / "pmvs2.log"},
-                     &commands);
-      r.cloud = ReadPly(input / "models" / "option.ply");
-      Translate(&r.cloud, origin);
-      rows.push_back(std::move(r));
+      // PMVS2 on `folder` as the row `name`, logged to logs/`log`.
+      auto run_pmvs2 = [&](std::string name, const fs::path& folder, const std::string& log) {
+        Row r;
+        r.name = std::move(name);
+        // PMVS2 joins the prefix and its file names as strings.
+        r.usage =
+            Step({{pmvs2.string(), folder.string() + "/", "option"}, {}, logs / log}, &commands);
+        r.cloud = ReadPly(folder / "models" / "option.ply");
+        Translate(&r.cloud, origin);
+        rows.push_back(std::move(r));
+      };
+      run_pmvs2(shift_pyramid ? "PMVS2, P shifted for its pyramid" : "PMVS2", input, "pmvs2.log");
       // Its threads take the patches in whatever order they finish, so two
       // runs on the same input differ: the second one's row is how much of
       // PMVS2's cloud PMVS2 itself covers, the scale of the other rows'.
       if (again) {
         const fs::path repeat = out / "pmvs2_again";
         WriteRepeatFolder(input, repeat);
-        Row second;
-        second.name = rows.back().name + ", second run";
-        second.usage =
-            Step({{pmvs2.string(), repeat.string() + "/", "option"}, {}, logs / "pmvs2_again.log"},
-                 &commands);
-        second.cloud = ReadPly(repeat / "models" / "option.ply");
-        Translate(&second.cloud, origin);
-        rows.push_back(std::move(second));
+        run_pmvs2(rows.back().name + ", second run", repeat, "pmvs2_again.log");
       }
     }
     for (const std::string& mode : modes) {
