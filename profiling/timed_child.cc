@@ -5,12 +5,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <thread>
 #include <utility>
 
 #include "sapmvs/util/error.h"
@@ -62,6 +65,58 @@ std::pair<double, double> StealAndTotalJiffies() {
   return {field[7], total};
 }
 
+// VmRSS, RssAnon and RssFile + RssShmem of a process, KiB, from
+// /proc/PID/status; false once it has exited (a zombie's status has none).
+bool ReadMemory(pid_t pid, double* rss, double* anonymous, double* files) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/status");
+  std::string key;
+  double value = 0;
+  int found = 0;
+  *files = 0;
+  while (f >> key) {
+    if (key == "VmRSS:" && f >> value) *rss = value, found |= 1;
+    if (key == "RssAnon:" && f >> value) *anonymous = value, found |= 2;
+    if ((key == "RssFile:" || key == "RssShmem:") && f >> value) *files += value, found |= 4;
+    f.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+  }
+  return found == 7;
+}
+
+// Samples the memory of `pid` every kMemorySampleMs until stopped.
+class MemorySampler {
+ public:
+  explicit MemorySampler(pid_t pid) : thread_([this, pid] { Run(pid); }) {}
+  ~MemorySampler() { Stop(); }
+  void Stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  // Into `u` (after Stop): the parts of the sample of the largest RSS.
+  void Report(ChildUsage* u) const {
+    if (samples_ == 0) return;
+    u->files_at_peak_mib = files_at_peak_ / 1024;
+    u->anonymous_at_peak_mib = anonymous_at_peak_ / 1024;
+  }
+
+ private:
+  void Run(pid_t pid) {
+    while (!stop_) {
+      double rss = 0, anonymous = 0, files = 0;
+      if (ReadMemory(pid, &rss, &anonymous, &files)) {
+        ++samples_;
+        if (rss > peak_rss_)
+          peak_rss_ = rss, files_at_peak_ = files, anonymous_at_peak_ = anonymous;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(kMemorySampleMs));
+    }
+  }
+
+  std::atomic<bool> stop_{false};
+  long samples_ = 0;
+  double peak_rss_ = 0, files_at_peak_ = 0, anonymous_at_peak_ = 0;
+  std::thread thread_;  // last: starts once the members above are set
+};
+
 }  // namespace
 
 ChildUsage RunTimed(const ChildCommand& command) {
@@ -99,6 +154,14 @@ ChildUsage RunTimed(const ChildCommand& command) {
   int exec_errno = 0;
   const bool exec_failed = read(report[0], &exec_errno, sizeof exec_errno) == sizeof exec_errno;
   close(report[0]);
+  // The sampler stops once the child has exited but before it is reaped:
+  // until then its pid cannot name another process.
+  MemorySampler sampler(pid);
+  siginfo_t exited{};
+  while (waitid(P_PID, pid, &exited, WEXITED | WNOWAIT) < 0) {
+    if (errno != EINTR) break;  // wait4 below reports it
+  }
+  sampler.Stop();
   int status = 0;
   rusage usage{};
   while (wait4(pid, &status, 0, &usage) < 0) {
@@ -110,6 +173,7 @@ ChildUsage RunTimed(const ChildCommand& command) {
   const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
   u.cpu_seconds = seconds(usage.ru_utime) + seconds(usage.ru_stime);
   u.peak_rss_mib = usage.ru_maxrss / 1024.0;  // Linux reports KiB
+  sampler.Report(&u);
   const auto [steal_after, total_after] = StealAndTotalJiffies();
   if (total_before > 0 && total_after > total_before) {
     u.host_steal = (steal_after - steal_before) / (total_after - total_before);

@@ -9,6 +9,10 @@
 
 namespace sapmvs {
 
+// How often RunTimed samples a command's memory. Reading /proc/PID/status
+// reads counters, not the page tables: about 30 us a sample.
+constexpr int kMemorySampleMs = 10;
+
 struct ChildCommand {
   std::vector<std::string> argv;  // argv[0]: a path, or a name looked up on PATH
   // Set in the child's environment only (e.g. POCL_CPU_MAX_CU_NUM).
@@ -25,6 +29,14 @@ struct ChildUsage {
   double wall_seconds = 0;
   double cpu_seconds = 0;   // user + system, all its threads and waited-for children
   double peak_rss_mib = 0;  // ru_maxrss
+  // What the peak is made of, from /proc/PID/status sampled every
+  // kMemorySampleMs while the command runs (its own process, not its
+  // children), in the sample of the largest VmRSS; -1 where no sample was
+  // taken. A library's pages count in the RSS once mapped and touched,
+  // whoever else maps them, and are dropped without a write when memory runs
+  // short: the two parts tell what a program loads from what it allocates.
+  double files_at_peak_mib = -1;      // RssFile + RssShmem: libraries, mapped files
+  double anonymous_at_peak_mib = -1;  // RssAnon: heap, stacks, written library pages
   // Share of the machine's CPU time that its hypervisor gave to other guests
   // while the command ran ("steal" in /proc/stat, all CPUs); -1 where the
   // system does not say. A shared virtual machine's CPU/wall falls with it

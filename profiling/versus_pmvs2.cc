@@ -28,6 +28,11 @@
 // block's DEM or ground height) is taken out of sapmvs_frame.json, so sapmvs
 // finds its depths from tie points, as PMVS2 from its own seeds.
 //
+// Memory: the peak RSS is wait4()'s, as `/usr/bin/time` gives it. Beside it,
+// from the child's /proc/PID/status sampled every 10 ms (RunTimed), the two
+// parts of the largest sample: files mapped (the libraries, PoCL's LLVM
+// among them) and anonymous memory (what the program allocated and wrote).
+//
 // Distances: cloud-to-cloud coverage is counted within 1 and 2 GSD of the
 // matched level (the median full-resolution GSD at the scene times
 // 2^level), the spacing both matchers emit points at. Against the truth the
@@ -248,12 +253,14 @@ std::string Fixed(double v, int digits) {
   s << std::fixed << std::setprecision(digits) << v;
   return s.str();
 }
+// A sampled memory figure, "–" where none was sampled (< 0).
+std::string MiB(double v) { return v >= 0 ? Fixed(v, 0) : "–"; }
 std::string Share(const std::optional<double>& v) { return v ? Fixed(100 * *v, 1) + " %" : "–"; }
 
 std::string Table(const std::vector<Row>& rows, bool with_truth) {
   std::ostringstream t;
   t << "| tool / mode | wall s | CPU s | CPU/wall | matching CPU/wall | host steal | peak RSS MiB "
-       "| points "
+       "| of it files MiB | of it anonymous MiB | points "
        "| PMVS2→ours 1 GSD | PMVS2→ours 2 GSD | ours→PMVS2 1 GSD | ours→PMVS2 2 GSD | PMVS2→our "
        "surface 2 GSD | ours→PMVS2's surface 2 GSD |";
   if (with_truth) {
@@ -261,7 +268,7 @@ std::string Table(const std::vector<Row>& rows, bool with_truth) {
          "median \\|dz\\| | coverage | within 2 "
          "GSD (3D) |";
   }
-  t << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  t << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     << (with_truth ? "---|---|---|---|---|---|" : "") << "\n";
   for (const Row& r : rows) {
     const ChildUsage& u = r.usage;
@@ -270,9 +277,10 @@ std::string Table(const std::vector<Row>& rows, bool with_truth) {
         << " | " << Fixed(u.cpu_seconds / std::max(u.wall_seconds, 1e-9), 2) << " | "
         << (r.matching_busy ? Fixed(*r.matching_busy, 2) : "–") << " | "
         << (u.host_steal >= 0 ? Fixed(100 * u.host_steal, 0) + " %" : "–") << " | "
-        << Fixed(u.peak_rss_mib, 0) << " | ";
+        << Fixed(u.peak_rss_mib, 0) << " | " << MiB(u.files_at_peak_mib) << " | "
+        << MiB(u.anonymous_at_peak_mib) << " | ";
     } else {
-      t << "| " << r.name << " | – | – | – | – | – | – | ";
+      t << "| " << r.name << " | – | – | – | – | – | – | – | – | ";
     }
     t << r.cloud.points.size() << " | " << Share(r.from_pmvs2[0]) << " | " << Share(r.from_pmvs2[1])
       << " | " << Share(r.to_pmvs2[0]) << " | " << Share(r.to_pmvs2[1]) << " | "
