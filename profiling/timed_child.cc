@@ -74,9 +74,16 @@ bool ReadMemory(pid_t pid, double* rss, double* anonymous, double* files) {
   int found = 0;
   *files = 0;
   while (f >> key) {
-    if (key == "VmRSS:" && f >> value) *rss = value, found |= 1;
-    if (key == "RssAnon:" && f >> value) *anonymous = value, found |= 2;
-    if ((key == "RssFile:" || key == "RssShmem:") && f >> value) *files += value, found |= 4;
+    if (key == "VmRSS:" && f >> value) {
+      *rss = value;
+      found |= 1;
+    } else if (key == "RssAnon:" && f >> value) {
+      *anonymous = value;
+      found |= 2;
+    } else if ((key == "RssFile:" || key == "RssShmem:") && f >> value) {
+      *files += value;
+      found |= 4;
+    }
     f.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
   }
   return found == 7;
@@ -104,8 +111,11 @@ class MemorySampler {
       double rss = 0, anonymous = 0, files = 0;
       if (ReadMemory(pid, &rss, &anonymous, &files)) {
         ++samples_;
-        if (rss > peak_rss_)
-          peak_rss_ = rss, files_at_peak_ = files, anonymous_at_peak_ = anonymous;
+        if (rss > peak_rss_) {
+          peak_rss_ = rss;
+          files_at_peak_ = files;
+          anonymous_at_peak_ = anonymous;
+        }
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(kMemorySampleMs));
     }
@@ -161,6 +171,8 @@ ChildUsage RunTimed(const ChildCommand& command) {
   while (waitid(P_PID, pid, &exited, WEXITED | WNOWAIT) < 0) {
     if (errno != EINTR) break;  // wait4 below reports it
   }
+  // Before the sampler's last sleep, which would add up to kMemorySampleMs.
+  const auto end = std::chrono::steady_clock::now();
   sampler.Stop();
   int status = 0;
   rusage usage{};
@@ -169,7 +181,7 @@ ChildUsage RunTimed(const ChildCommand& command) {
   }
   if (exec_failed) throw Error(command.argv[0] + ": cannot run: " + strerror(exec_errno));
   ChildUsage u;
-  u.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  u.wall_seconds = std::chrono::duration<double>(end - start).count();
   const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
   u.cpu_seconds = seconds(usage.ru_utime) + seconds(usage.ru_stime);
   u.peak_rss_mib = usage.ru_maxrss / 1024.0;  // Linux reports KiB
