@@ -108,10 +108,7 @@ TEST_F(VersusPmvs2Test, RunsPmvs2TwiceAndComparesEachCloudWithTheFirst) {
       Versus("--modes sapmvs --pmvs2-again --truth " +
              (block_.parent_path() / "truth" / "dsm.tif").string() + " --markdown " + md.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::ifstream in(md);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string markdown = text.str();
+  const std::string markdown = test::Slurp(md);
   // The same table on stdout and in the file the benchmark appends to.
   EXPECT_NE(r.out.find(markdown), std::string::npos);
 
@@ -170,10 +167,8 @@ TEST_F(VersusPmvs2Test, AFailingPmvs2EndsTheBenchmarkNamingItsLog) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("pmvs2.log"), std::string::npos) << r.err;
   EXPECT_EQ(test::CountLines(r.err.substr(r.err.find("versus_pmvs2:"))), 1) << r.err;
-  std::ifstream log(dir_ / "out" / "logs" / "pmvs2.log");
-  std::stringstream text;
-  text << log.rdbuf();
-  EXPECT_NE(text.str().find("without CPU 1"), std::string::npos) << text.str();
+  const std::string log = test::Slurp(dir_ / "out" / "logs" / "pmvs2.log");
+  EXPECT_NE(log.find("without CPU 1"), std::string::npos) << log;
 }
 
 TEST_F(VersusPmvs2Test, RefusesASecondPmvs2RunOfAnEarlierCloud) {
