@@ -3,9 +3,18 @@
 # synthetic block (simulate -> info -> plan -> run -> evaluate against the
 # simulated LiDAR), and describes a real aerial block (NGI, from ../shared)
 # when it is there.
+#
+# Builds only the `sapmvs` binary (and the GDAL module it loads), not the
+# tests and benchmarks: scripts/build.sh builds everything, scripts/test.sh
+# the tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/build.sh
+bash scripts/install-deps.sh
+jobs=$(nproc 2>/dev/null || echo 2)
+if [ ! -f build/CMakeCache.txt ]; then
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+fi
+cmake --build build --target sapmvs -j"$jobs"
 out=out/demo
 echo
 echo "== sapmvs devices"
