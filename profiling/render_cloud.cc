@@ -1,4 +1,4 @@
-// A picture of a dense cloud for the README and for eyeballing a run: the
+// A picture of a dense cloud for the docs and for eyeballing a run: the
 // points are splatted through one of the block's cameras (or straight down),
 // nearest first, in their own colour or coloured by height.
 //

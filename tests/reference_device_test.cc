@@ -26,7 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The tolerance README's "Devices" states. A reference point agrees when an
+// The tolerance docs/devices.md states. A reference point agrees when an
 // OpenCL point lies within kAgreeRadiusGsd full-resolution GSDs of it (the
 // tiny block is matched at level 1, whose footprint is 2 GSD). Against PoCL
 // 98.9 % of the reference's points and 98.8 % of PoCL's agree, and the counts

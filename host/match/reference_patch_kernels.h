@@ -4,7 +4,7 @@
 // batch with OpenMP. It makes no OpenCL call, so `--device reference` runs the
 // whole matcher where no OpenCL platform is installed; its results agree with
 // a device's to float32 rounding, which can flip near-ties of the refinement
-// and so move a few points (README "Devices" gives the measured agreement).
+// and so move a few points (docs/devices.md gives the measured agreement).
 
 #include <memory>
 

@@ -1,7 +1,7 @@
 #pragma once
 // Block readers. The format is detected from the path given (a file or a
 // folder) unless BlockReadOptions::format names it.
-//   yaml     native block.yaml (see docs in README.md, "Block files")
+//   yaml     native block.yaml (docs/running.md, "Inputs: block files")
 //   pmvs     PMVS/CMVS folder: txt/NNNNNNNN.txt (CONTOUR + 3x4 P), visualize/
 //   colmap   COLMAP model, binary (cameras.bin, images.bin + points3D.bin) or
 //            text (cameras.txt, images.txt + points3D.txt); binary when a

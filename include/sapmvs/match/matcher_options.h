@@ -129,7 +129,7 @@ struct MatcherOptions {
   double canny_high = 120;
   // The paper's edge barriers, off by default: matching the edges took 10-20 %
   // of sapmvs's time on `small`, `city` and Herz-Jesu-P8 and changed none of
-  // their clouds measurably (README, "Which points a sapmvs patch writes"),
+  // their clouds measurably (docs/method.md 3.7),
   // since emit_min_weight already stops a window at the edges it straddles.
   bool use_edges = false;
   // Expand-then-filter passes (PMVS: n = 3). Each pass after the first frees

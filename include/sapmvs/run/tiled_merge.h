@@ -22,7 +22,7 @@
 // may be kept that the global merge drops, or the other way, and two tiles'
 // kept points may then be a duplicate pair across the border. The unit test
 // (tiled_merge_test.cc) bounds the difference on a synthetic multi-tile
-// block; on `small` cut into tiles it is measured in README.md. A block that
+// block; on `small` cut into tiles it is measured in docs/running.md. A block that
 // fits in one tile is merged exactly as MergeGroupClouds merges it, and
 // comes out in the same order: byte-identical outputs.
 
