@@ -1,4 +1,4 @@
-// Batched patch refinement (issue 4, "Kernels"): one work-item per patch
+// Batched patch refinement: one work-item per patch
 // optimises the patch's depth along its reference ray and the two angles of
 // its normal to maximise the mean NCC over its views, all iterations
 // in-kernel. See kernels/README.md ("patch_refine.cl") for the data layout and

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Per-group memory of `sapmvs run`s: the plan's estimate beside the measured
-peak RSS, from each run's report.json (issue #18). Usage:
+peak RSS, from each run's report.json. Usage:
   memory_table.py NAME=RUN_DIR [NAME=RUN_DIR ...]
 Prints a Markdown table; the last column is estimate / measured - 1."""
 import json

@@ -222,8 +222,8 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
 }
 
 // Each group's measured peak sits beside the plan's estimate, within the
-// issue's 25 %; a budget below the default group splits the block, and the
-// run stays within it (plus the 10 %).
+// 25 % the estimate is meant to hold; a budget below the default group
+// splits the block, and the run stays within it (plus 10 %).
 TEST_F(CliRunTest, MemoryEstimateHoldsAndABudgetSplitsTheBlock) {
   SAPMVS_REQUIRE_OPENCL_DEVICE();
   auto check_groups = [](const nlohmann::json& report) {

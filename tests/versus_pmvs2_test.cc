@@ -1,4 +1,4 @@
-// profiling/versus_pmvs2, the benchmark that issue 15's acceptance reads,
+// profiling/versus_pmvs2, the benchmark behind profiling/results/versus_pmvs2.md,
 // run end to end with a stand-in for PMVS2: PMVS2 is built by hand outside
 // the tree (profiling/anchors/) and is not on CI's machines, so without this
 // nothing but a person running it would notice the benchmark break. The

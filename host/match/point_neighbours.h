@@ -2,12 +2,12 @@
 // Each point's nearest others within a radius of its own: the neighbourhoods
 // the filter's plane, patch-support and cluster tests read.
 //
-// FLANN's kd-tree answered "the k nearest" until the eighteenth stop, and the
-// filter then dropped those beyond the radius. Its build is serial (one core
+// Not FLANN's kd-tree (replaced in fa0c7a8): it answers "the k nearest", which
+// the filter would then cut to the radius; its build is serial (one core
 // idle for a tenth of a second per filter pass on the simulator's `city`)
-// and its results, in size_t, were searched in chunks to bound their memory.
-// The radius is known before the search, so a grid of cells half a median
-// radius wide finds the same neighbours with an O(n) build: points lie on
+// and its results, in size_t, must be searched in chunks to bound their
+// memory. The radius is known before the search, so a grid of cells half a
+// median radius wide finds the same neighbours with an O(n) build: points lie on
 // surfaces, so the grid is dense in the two axes the cloud spans most and
 // sorted along the third. Columns are read in rings around the point's and
 // skipped once they lie beyond the k-th nearest found so far.

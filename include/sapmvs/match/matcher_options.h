@@ -67,7 +67,7 @@ struct MatcherOptions {
   // the larger size in enough views, over the window and in each corner
   // sub-window: the plane must be shown to hold over the larger window
   // before the larger window may write points. With PMVS's
-  // threshold_before (0.4, the rule until the eleventh stop; 0 here) most
+  // threshold_before (0.4, grow_threshold 0 here) most
   // polishes failed and the large patches that passed were the least
   // accurate. One group, one run each, 0.4 -> 0.9: `small` 96.7 -> 97.6 %
   // within 1 GSD, coverage 74.4 -> 75.7 %, time -19 %; `city` 90.7 -> 94.7 %,

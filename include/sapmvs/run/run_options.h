@@ -34,7 +34,7 @@ struct RunOptions {
   // Discard DIR/groups/ and start over instead of resuming.
   bool restart = false;
   // Match at most this many groups in this call, then stop (resumable);
-  // 0 = all. For splitting a long run into sessions.
+  // 0 = all. For matching a long block over several calls.
   int max_groups = 0;
   // Merge: a point is a duplicate of another group's point within this many
   // ground sample distances of the matched level. > 0.
