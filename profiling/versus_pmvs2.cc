@@ -57,6 +57,8 @@
 #include "sapmvs/util/error.h"
 #include "timed_child.h"
 #include "truth_check.h"
+#include "util/build_info.h"
+#include "util/machine_info.h"
 
 using namespace sapmvs;
 namespace fs = std::filesystem;
@@ -495,7 +497,15 @@ int main(int argc, char** argv) {
 
     std::ostringstream md;
     md << "### " << block_path << ", level " << level << ", " << images << " images, " << threads
-       << " threads\n\n"
+       << " threads\n\n";
+    // What a results file needs to be read alone: the commit, the machine
+    // and the command that made the table.
+    const MachineInfo machine = DescribeMachine();
+    ChildCommand self;
+    self.argv.assign(argv, argv + argc);
+    md << "sapmvs " << BuildVersion() << " (commit " << BuildCommit() << "); "
+       << (machine.cpu_model.empty() ? "unknown CPU" : machine.cpu_model) << ", " << machine.cores
+       << " logical CPUs; `" << self.ShellLine() << "`.\n\n"
        << "GSD " << Fixed(gsd, 4) << " at full resolution, " << Fixed(gsd_level, 4) << " at level "
        << level << " (the cloud-to-cloud distances)";
     if (truth) md << "; truth " << truth_path << " (within 1 full-resolution GSD)";
