@@ -10,9 +10,18 @@
 // merge) against the surface its own images see: does a short group (the
 // paper's 4-image groups) cover its ground as well as a 6-image one?
 //
-//   group_borders RUN_DIR --block BLOCK --truth truth/dsm.tif [--band 20] [--per-group]
+// Without truth (a real block), and with it: steps in the run's DSM. For
+// every two cells side by side, the height difference; pairs whose cells
+// lie in different groups' cores cross a border, the others are inside a
+// group. Groups that place the surface differently leave a step where their
+// cores meet, and the pairs across borders then differ more than those
+// inside.
+//
+//   group_borders RUN_DIR --block BLOCK [--truth truth/dsm.tif] [--band 20] [--per-group]
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -56,6 +65,57 @@ std::vector<Eigen::Vector2d> ReportCenters(const nlohmann::json& report) {
   return centers;
 }
 
+// Median, 90th and 99th percentile of `v` (reordered); zeros when empty.
+std::array<double, 3> Quantiles(std::vector<double>& v) {
+  std::array<double, 3> q = {0, 0, 0};
+  if (v.empty()) return q;
+  const double at[3] = {0.5, 0.9, 0.99};
+  for (int k = 0; k < 3; ++k) {
+    const auto nth =
+        v.begin() + static_cast<long>(std::min(v.size() - 1, size_t(at[k] * v.size())));
+    std::nth_element(v.begin(), nth, v.end());
+    q[k] = *nth;
+  }
+  return q;
+}
+
+// The DSM steps (see the top of this file) of `dsm`, printed.
+void PrintDsmSteps(const GeoRaster& dsm, const std::vector<Eigen::Vector2d>& centers) {
+  std::vector<int> owner(dsm.values.size(), -1);
+  for (int r = 0; r < dsm.height; ++r) {
+    for (int c = 0; c < dsm.width; ++c) {
+      if (dsm.IsEmpty(c, r)) continue;
+      const Eigen::Vector2d p = dsm.CellCenter(c, r);
+      owner[static_cast<size_t>(r) * dsm.width + c] = CoreOwner(centers, p.x(), p.y());
+    }
+  }
+  std::vector<double> across, inside;
+  for (int r = 0; r < dsm.height; ++r) {
+    for (int c = 0; c < dsm.width; ++c) {
+      const int a = owner[static_cast<size_t>(r) * dsm.width + c];
+      if (a < 0) continue;
+      for (const auto& [dc, dr] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        if (c + dc >= dsm.width || r + dr >= dsm.height) continue;
+        const int b = owner[static_cast<size_t>(r + dr) * dsm.width + c + dc];
+        if (b < 0) continue;
+        const double dz = std::abs(double(dsm.at(c, r)) - dsm.at(c + dc, r + dr));
+        (a == b ? inside : across).push_back(dz);
+      }
+    }
+  }
+  std::cout << "DSM steps (cell " << dsm.cell_size << "): neighbouring cells' |dz|\n"
+            << "pairs              count     median        p90        p99\n";
+  const std::pair<const char*, std::vector<double>*> sets[] = {{"inside groups", &inside},
+                                                               {"across borders", &across}};
+  for (const auto& [name, v] : sets) {
+    const std::array<double, 3> q = Quantiles(*v);
+    std::cout << std::left << std::setw(14) << name << std::right << std::setw(10) << v->size()
+              << std::fixed << std::setprecision(4) << std::setw(11) << q[0] << std::setw(11)
+              << q[1] << std::setw(11) << q[2] << "\n";
+    std::cout.unsetf(std::ios::floatfield);
+  }
+}
+
 nlohmann::json ReadReport(const std::filesystem::path& dir) {
   std::ifstream f(dir / "report.json");
   if (!f) throw Error((dir / "report.json").string() + ": cannot read");
@@ -71,7 +131,8 @@ int main(int argc, char** argv) {
   int level = 1;
   app.add_option("run", run_dir, "Output folder of `sapmvs run`")->required();
   app.add_option("--block", block_path, "The block that was run")->required();
-  app.add_option("--truth", truth_path, "True surface raster (truth/dsm.tif)")->required();
+  app.add_option("--truth", truth_path,
+                 "True surface raster (truth/dsm.tif); without it only the DSM steps");
   app.add_option("--band", band_gsd, "Border zone half-width, block GSDs")->capture_default_str();
   app.add_option("--duplicate", duplicate_gsd, "Cross-group duplicate distance, block GSDs")
       ->capture_default_str();
@@ -102,6 +163,8 @@ int main(int argc, char** argv) {
       throw Error("report.json's kept_after_merge counts do not add up to cloud.ply's points");
     }
     const Block block = ReadBlock(block_path);
+    if (centers.size() > 1) PrintDsmSteps(ReadGeoRaster(dir / "dsm.tif"), centers);
+    if (truth_path.empty()) return 0;
     const GeoRaster truth = ReadGeoRaster(truth_path);
     const double gsd = EstimateBlockGeometry(block).gsd_median;
     const double band = band_gsd * gsd;

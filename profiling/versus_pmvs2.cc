@@ -55,6 +55,7 @@
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/run/cloud_merge.h"
 #include "sapmvs/util/error.h"
+#include "surface_table.h"
 #include "timed_child.h"
 #include "truth_check.h"
 #include "util/build_info.h"
@@ -93,6 +94,8 @@ struct Row {
   // included) of the true surface. On PMVS2's row it is the most of PMVS2's
   // points that any accurate cloud can have a point within 2 GSD of.
   std::optional<double> near_truth;
+  // sapmvs: its output folder (report.json, groups/).
+  fs::path run;
   // sapmvs: CPU / wall over its matching stages (report.json), without the
   // reading, planning, merging and writing around them.
   std::optional<double> matching_busy;
@@ -438,6 +441,7 @@ int main(int argc, char** argv) {
       r.usage = Step(c, &commands);
       r.cloud = ReadPly(run / "cloud.ply");
       r.matching_busy = MatchingBusy(run / "report.json");
+      r.run = run;
       rows.push_back(std::move(r));
     }
 
@@ -510,6 +514,11 @@ int main(int argc, char** argv) {
        << level << " (the cloud-to-cloud distances)";
     if (truth) md << "; truth " << truth_path << " (within 1 full-resolution GSD)";
     md << ".\n\n" << Table(rows, truth.has_value()) << "\n";
+    std::vector<SurfaceRow> surface;
+    for (const Row& r : rows) surface.push_back({r.name, &r.cloud, r.run});
+    md << "Without truth (distances in CRS units; noise within " << Fixed(4 * gsd_level, 4)
+       << ", 4 GSD):\n\n"
+       << SurfaceTable(surface, gsd_level) << "\n";
     if (!have_pmvs2) md << "PMVS2 not built: skipped.\n\n";
     if (!pmvs2_cloud.empty())
       md << "PMVS2's cloud from an earlier run: its times are not shown.\n\n";
