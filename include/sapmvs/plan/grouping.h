@@ -94,6 +94,23 @@ struct ImageGroup {
   std::vector<int> short_of_views;
 };
 
+// An image that belongs to no flight strip (DetectStrips), and why. It still
+// joins the group whose ground it sees best (PlanGroups), as an image or,
+// when that group is full or the image sees the ground at another scale, as
+// a view.
+enum class OutlierKind {
+  kClimb,  // height above the ground far from the strips' (climb, descent)
+  kTurn,   // between two strips, off both (a turn, a side step)
+  kStray,  // before the first strip or after the last, off both
+};
+std::string ToString(OutlierKind kind);  // "climb", "turn", "stray"
+
+struct StripOutlier {
+  int image = -1;
+  OutlierKind kind = OutlierKind::kStray;
+  std::string reason;  // for people: what sets it apart, with the numbers
+};
+
 struct GroupingPlan {
   GroupingStrategy strategy = GroupingStrategy::kStrip;
   GroupingOptions options;  // what the plan was made with
@@ -101,6 +118,7 @@ struct GroupingPlan {
   // memory estimate) and min_image_num (short runs, short_of_views).
   MatcherOptions matcher;
   std::vector<std::vector<int>> strips;  // detected strips, images in flight order
+  std::vector<StripOutlier> outliers;    // images of no strip, in flight order
   std::vector<ImageGroup> groups;
   std::vector<int> ungrouped;  // images in no group (see PlanGroups)
   // The whole block is one group: it has at most max_images images and fits
