@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 
+#include "plan/grouping_internal.h"
 #include "plan/strip_detection.h"
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/match/match_group.h"
@@ -135,15 +136,25 @@ TEST(GroupingStrips, StripViewsComeFromTheNeighbouringStrips) {
               plan.groups[g].views);
     EXPECT_LE(wide.groups[g].views.size(), 5u);
   }
+  // Without them, a group takes views only where its own images do not
+  // span twice max_angle_deg (10) at their ground, and then as many as do.
+  const std::vector<Footprint> fp = Footprints(s.block, EstimateBlockGeometry(s.block));
+  auto span = [&](const ImageGroup& g, const std::vector<int>& ids) {
+    const Eigen::Vector2d c = MeanCenter(fp, g.images);
+    return SpanDeg(s.block, ids, Eigen::Vector3d(c.x(), c.y(), fp[g.images[0]].scene_z), 60);
+  };
   GroupingOptions none = o;
   none.strip_views = 0;
-  for (const ImageGroup& g : PlanGroups(s.block, none, MatcherOptions{}).groups)
-    EXPECT_TRUE(g.views.empty());
-  // The footprint strategy chooses its images per tile and takes none.
+  for (const ImageGroup& g : PlanGroups(s.block, none, MatcherOptions{}).groups) {
+    EXPECT_EQ(g.views.empty(), span(g, g.images) >= 20) << span(g, g.images);
+    EXPECT_GE(span(g, g.MatchedIn()), 20);
+  }
+  // The footprint strategy chooses its images per tile; its views are the
+  // images no tile chose and those that widen the angle.
   GroupingOptions tiles = o;
   tiles.strategy = GroupingStrategy::kFootprint;
   for (const ImageGroup& g : PlanGroups(s.block, tiles, MatcherOptions{}).groups)
-    EXPECT_TRUE(g.views.empty());
+    EXPECT_GE(span(g, g.MatchedIn()), 20);
 }
 
 // A view-only image counts in the memory budget: under a budget that holds 6
@@ -209,7 +220,7 @@ TEST(GroupingTable3, GroupCentresLieOnTheirImagesFootprints) {
 TEST(GroupingStrips, CrossStripIsItsOwnStrip) {
   const SimBlock s = MakeSimBlock("campus", /*cross_strip=*/true);
   ASSERT_GT(s.block.images.size(), 67u);
-  const std::vector<std::vector<int>> strips = DetectStrips(s.block);
+  const std::vector<std::vector<int>> strips = DetectStrips(s.block).strips;
   EXPECT_EQ(strips, TrueStrips(s));
   ASSERT_EQ(strips.size(), 5u);
   EXPECT_EQ(strips[4].size(), s.block.images.size() - 67);
@@ -261,19 +272,28 @@ TEST(GroupingStrips, StripFlownBackwardsKeepsFlightOrder) {
   EXPECT_EQ(StripNames(shuffled.block, strips), StripNames(s.block, plan.strips));
 }
 
-TEST(GroupingStrips, RemainderOfOneBorrowsFromThePreviousRun) {
-  // 13 images: 6 + 6 + 1 would leave an image with nothing to match.
+TEST(GroupingStrips, ShortRemainderMovesTheCutsBack) {
+  // 13 images: 6 + 6 + 1 would leave an image with nothing to match, and
+  // 6 + 5 + 2 a group under the paper's smallest (4).
   SimBlock s = MakeSimBlock("campus", false, {0});
   s.block.images.resize(13);
-  // 6 + 5 + 2, and the run of 2 takes image 10 too: a patch needs 3 images
-  // (min_image_num), so a group of 2 would match nothing.
   const GroupingPlan plan13 = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
-  EXPECT_EQ(Sizes(plan13), (std::vector<size_t>{6, 5, 3}));
-  EXPECT_EQ(plan13.groups[2].images.front(), plan13.groups[1].images.back());
-  for (const ImageGroup& g : plan13.groups) EXPECT_TRUE(g.short_of_views.empty());
+  EXPECT_EQ(Sizes(plan13), (std::vector<size_t>{5, 4, 4}));
+  std::vector<int> all;
+  for (const ImageGroup& g : plan13.groups) {
+    EXPECT_TRUE(g.short_of_views.empty());
+    all.insert(all.end(), g.images.begin(), g.images.end());
+  }
+  EXPECT_EQ(all, plan13.strips[0]);  // each image once, in flight order
   MatcherOptions pairs;
   pairs.min_image_num = 2;
-  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{}, pairs)), (std::vector<size_t>{6, 5, 2}));
+  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{}, pairs)), (std::vector<size_t>{5, 4, 4}));
+  // 14 -> 6 + 4 + 4: the full runs first, as the paper's.
+  s = MakeSimBlock("campus", false, {0});
+  s.block.images.resize(14);
+  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{}, MatcherOptions{})),
+            (std::vector<size_t>{6, 4, 4}));
+  // Groups of 2 cannot have 4: a single image left shares the one before.
   GroupingOptions two;
   two.max_images = 2;
   s.block.images.resize(5);
@@ -293,7 +313,11 @@ TEST(GroupingStrips, LoneImageJoinsTheNearestGroup) {
                                     AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
   s.block.images.push_back(stray);
   const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
-  EXPECT_EQ(plan.strips.size(), 2u);
+  // Off the strip's line after its end: a stray, not a strip of its own.
+  EXPECT_EQ(plan.strips.size(), 1u);
+  ASSERT_EQ(plan.outliers.size(), 1u);
+  EXPECT_EQ(plan.outliers[0].image, 16);
+  EXPECT_EQ(plan.outliers[0].kind, OutlierKind::kStray);
   EXPECT_TRUE(plan.ungrouped.empty());
   int holder = -1;
   for (size_t g = 0; g < plan.groups.size(); ++g)
@@ -560,18 +584,6 @@ TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {
   EXPECT_FALSE(bad.Check());
   const SimBlock s = MakeSimBlock("tiny");
   EXPECT_THROW(PlanGroups(s.block, bad, MatcherOptions{}), Error);
-}
-
-TEST(GroupingOptions, StrategyNames) {
-  EXPECT_EQ(ParseGroupingStrategy("strip"), GroupingStrategy::kStrip);
-  EXPECT_EQ(ParseGroupingStrategy("footprint"), GroupingStrategy::kFootprint);
-  EXPECT_EQ(ToString(GroupingStrategy::kFootprint), "footprint");
-  try {
-    ParseGroupingStrategy("strips");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "unknown grouping strategy 'strips': expected strip or footprint");
-  }
 }
 
 TEST(GroupingPlan, TooFewImages) {

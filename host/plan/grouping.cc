@@ -13,6 +13,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "plan/grouping_internal.h"
 #include "plan/strip_detection.h"
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/match/match_group.h"
@@ -30,67 +31,10 @@ namespace {
 // left them with one view at the paper's 92 % forward overlap.
 constexpr int kTileSamples = 16;
 
-// Where each image sees the ground, local frame.
-struct Footprint {
-  bool valid = false;
-  std::array<Eigen::Vector2d, 4> corners;
-  Eigen::Vector2d center = Eigen::Vector2d::Zero();  // of the corners; camera XY when invalid
-  Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = Eigen::Vector2d::Zero();  // bounding box
-  double scene_z = 0;
-  double short_side = 0;
-
-  bool Contains(const Eigen::Vector2d& p) const {
-    if (!valid || (p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return false;
-    // Convex quad: p is inside when it lies on one side of every edge.
-    int pos = 0, neg = 0;
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector2d e = corners[(k + 1) % 4] - corners[k], q = p - corners[k];
-      const double c = e.x() * q.y() - e.y() * q.x();
-      pos += c > 0;
-      neg += c < 0;
-    }
-    return pos == 0 || neg == 0;
-  }
-};
-
-std::vector<Footprint> Footprints(const Block& block, const BlockGeometry& geometry) {
-  std::vector<Footprint> out(block.images.size());
-  for (size_t i = 0; i < out.size(); ++i) {
-    Footprint& f = out[i];
-    const ImageGeometry& g = geometry.images[i];
-    f.center = (block.images[i].camera.center() - block.origin).head<2>();
-    if (!g.valid) continue;
-    f.valid = true;
-    f.center.setZero();
-    for (int k = 0; k < 4; ++k) {
-      f.corners[k] = (g.footprint[k] - block.origin).head<2>();
-      f.center += f.corners[k] / 4;
-    }
-    f.lo = f.hi = f.corners[0];
-    for (const Eigen::Vector2d& c : f.corners) {
-      f.lo = f.lo.cwiseMin(c);
-      f.hi = f.hi.cwiseMax(c);
-    }
-    f.scene_z = g.scene_point.z() - block.origin.z();
-    f.short_side =
-        std::min((f.corners[1] - f.corners[0]).norm(), (f.corners[3] - f.corners[0]).norm());
-  }
-  return out;
-}
-
 std::string GroupNames(const Block& block, const std::vector<int>& ids) {
   std::string s;
   for (size_t k = 0; k < ids.size() && k < 4; ++k) s += (k ? ", " : "") + block.images[ids[k]].name;
   return ids.size() > 4 ? s + ", ..." : s;
-}
-
-// A group's estimate with the process around it (PlanGroups' process_bytes),
-// which is what memory_budget bounds.
-GroupMemory EstimateInProcess(const Block& block, const std::vector<int>& ids,
-                              const MatcherOptions& matcher, double process_bytes) {
-  GroupMemory mem = EstimateGroupMemory(block, ids, matcher);
-  mem.process_bytes = process_bytes;
-  return mem;
 }
 
 // Throws when the smallest group that can be matched does not fit: the
@@ -122,186 +66,147 @@ void CheckSmallestGroupFits(const Block& block, const GroupingOptions& o, const 
   }
 }
 
-// The plan's options and matcher say what a group may use.
-bool Fits(const Block& block, const std::vector<int>& ids, const GroupingPlan& plan) {
-  return EstimateInProcess(block, ids, plan.matcher, plan.process_bytes).Total() <=
-         plan.options.memory_budget;
-}
+// The paper's smallest group (Table 3: 16 images -> 6+6+4).
+constexpr size_t kSmallestGroup = 4;
 
-Eigen::Vector2d MeanCenter(const std::vector<Footprint>& fp, const std::vector<int>& ids) {
-  Eigen::Vector2d c = Eigen::Vector2d::Zero();
-  for (const int i : ids) c += fp[i].center;
-  return c / static_cast<double>(ids.size());
-}
-
-// Runs of at most k images; a single image left at the end takes one from
-// the run before it (k >= 3) or shares its last image (k = 2).
-std::vector<std::vector<int>> CutRuns(const std::vector<int>& strip, size_t k) {
+// Runs of at most k images, the last taking the remainder. A remainder
+// under m moves the cuts back until every run has m (13 -> 5+4+4, not
+// 6+6+1) when the strip has the images for it; otherwise a single image left
+// at the end takes one from the run before it (k >= 3) or shares its last
+// image (k = 2).
+std::vector<std::vector<int>> CutRuns(const std::vector<int>& strip, size_t k, size_t m) {
   std::vector<std::vector<int>> runs;
   for (size_t i = 0; i < strip.size(); i += k)
     runs.emplace_back(strip.begin() + i, strip.begin() + std::min(i + k, strip.size()));
-  if (runs.size() >= 2 && runs.back().size() == 1) {
-    std::vector<int>& prev = runs[runs.size() - 2];
+  const size_t r = runs.size();
+  if (r >= 2 && runs.back().size() < m && strip.size() >= m * r) {
+    std::vector<size_t> size(r, k);
+    size.back() = strip.size() - k * (r - 1);
+    for (size_t j = r - 1; j > 0 && size[j] < m; --j) {
+      const size_t need = m - size[j];
+      size[j] += need;
+      size[j - 1] -= need;
+    }
+    runs.clear();
+    size_t at = 0;
+    for (const size_t n : size) {
+      runs.emplace_back(strip.begin() + at, strip.begin() + at + n);
+      at += n;
+    }
+    return runs;
+  }
+  if (r >= 2 && runs.back().size() == 1) {
+    std::vector<int>& prev = runs[r - 2];
     runs.back().insert(runs.back().begin(), prev.back());
     if (prev.size() >= 3) prev.pop_back();
   }
   return runs;
 }
 
-// Share of image i's footprint that image j sees (7 x 7 samples, as
-// SelectViews counts views); 1 when either has no footprint, since nothing
-// then says they do not overlap.
-double OverlapShare(const std::vector<Footprint>& fp, int i, int j) {
-  if (!fp[i].valid || !fp[j].valid) return 1.0;
-  constexpr int kGrid = 7;
-  int inside = 0;
-  for (int gy = 0; gy < kGrid; ++gy) {
-    for (int gx = 0; gx < kGrid; ++gx) {
-      const double u = (gx + 0.5) / kGrid, v = (gy + 0.5) / kGrid;
-      const auto& c = fp[i].corners;
-      const Eigen::Vector2d p =
-          (1 - v) * ((1 - u) * c[0] + u * c[1]) + v * ((1 - u) * c[3] + u * c[2]);
-      inside += fp[j].Contains(p);
+// The runs of one strip, cut to fit the budget and each with the images a
+// patch needs (groups of strip `s`).
+void CutStrip(const Block& block, const GroupingOptions& o, const std::vector<int>& strip, int s,
+              GroupingPlan* plan) {
+  // One run length per strip keeps the paper's pattern (6+6+4) while the
+  // budget allows, and shortens every run of the strip when it does not.
+  std::vector<std::vector<int>> runs;
+  for (int k = o.max_images; k >= 2; --k) {
+    runs = CutRuns(strip, static_cast<size_t>(k), std::min<size_t>(kSmallestGroup, k));
+    if (std::all_of(runs.begin(), runs.end(),
+                    [&](const std::vector<int>& r) { return Fits(block, r, *plan); }))
+      break;
+  }
+  // A run of fewer images than a patch needs matches nothing (a strip of
+  // 17 cut 4+4+4+4+1 by the budget): it takes the strip images before it,
+  // which the run before it matched too; the merge keeps one of the
+  // duplicates.
+  for (size_t r = 1; r < runs.size(); ++r) {
+    std::vector<int>& run = runs[r];
+    auto first = std::find(strip.begin(), strip.end(), run.front());
+    while (static_cast<int>(run.size()) < std::min(plan->matcher.min_image_num, o.max_images) &&
+           first != strip.begin()) {
+      std::vector<int> with = run;
+      with.insert(with.begin(), *(first - 1));
+      if (!Fits(block, with, *plan)) break;
+      run = std::move(with);
+      --first;
     }
   }
-  return static_cast<double>(inside) / (kGrid * kGrid);
-}
-
-// Images of `ids` that overlap fewer than min_image_num - 1 others of
-// `matched_in` (ImageGroup::MatchedIn: ids and the group's views).
-std::vector<int> ShortOfViews(const std::vector<Footprint>& fp, const std::vector<int>& ids,
-                              int min_image_num, const std::vector<int>& matched_in) {
-  std::vector<int> out;
-  for (const int i : ids) {
-    int views = 0;
-    for (const int j : matched_in) views += j != i && OverlapShare(fp, i, j) >= 0.1;
-    if (views < min_image_num - 1) out.push_back(i);
+  for (std::vector<int>& run : runs) {
+    ImageGroup g;
+    g.images = std::move(run);
+    g.strip = s;
+    plan->groups.push_back(std::move(g));
   }
-  return out;
 }
 
+// Strip strategy. A strip too short for a group of its own (a broken strip,
+// a short cross strip) joins the nearest group with room for all of it, else
+// is a group when a patch can be matched in it, else its images join the
+// groups that see them best; so do the outliers (climb photos as views only:
+// their GSD is not the strips', so the merge should not get their points).
 void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<Footprint>& fp,
                 GroupingPlan* plan) {
-  std::vector<int> singles;
+  const size_t smallest = std::min<size_t>(kSmallestGroup, o.max_images);
+  std::vector<size_t> short_strips;
   for (size_t s = 0; s < plan->strips.size(); ++s) {
-    const std::vector<int>& strip = plan->strips[s];
-    if (strip.size() < 2) {
-      singles.push_back(strip[0]);
-      continue;
-    }
-    // One run length per strip keeps the paper's pattern (6+6+4) while the
-    // budget allows, and shortens every run of the strip when it does not.
-    std::vector<std::vector<int>> runs;
-    for (int k = o.max_images; k >= 2; --k) {
-      runs = CutRuns(strip, static_cast<size_t>(k));
-      if (std::all_of(runs.begin(), runs.end(),
-                      [&](const std::vector<int>& r) { return Fits(block, r, *plan); }))
-        break;
-    }
-    // A run of fewer images than a patch needs matches nothing (a strip of
-    // 14 cut 6+6+2): it takes the strip images before it, which the run
-    // before it matched too; the merge keeps one of the duplicates.
-    for (size_t r = 1; r < runs.size(); ++r) {
-      std::vector<int>& run = runs[r];
-      auto first = std::find(strip.begin(), strip.end(), run.front());
-      while (static_cast<int>(run.size()) < std::min(plan->matcher.min_image_num, o.max_images) &&
-             first != strip.begin()) {
-        std::vector<int> with = run;
-        with.insert(with.begin(), *(first - 1));
-        if (!Fits(block, with, *plan)) break;
-        run = std::move(with);
-        --first;
-      }
-    }
-    for (std::vector<int>& run : runs) {
-      ImageGroup g;
-      g.images = std::move(run);
-      g.strip = static_cast<int>(s);
-      plan->groups.push_back(std::move(g));
-    }
+    if (plan->strips[s].size() < smallest)
+      short_strips.push_back(s);
+    else
+      CutStrip(block, o, plan->strips[s], static_cast<int>(s), plan);
   }
   if (plan->groups.empty()) {
-    // No strip structure (a terrestrial or convergent block): its images in
-    // block order are the one strip.
+    // No strip structure (a terrestrial or convergent block, or one of a few
+    // images): its images in block order are the one strip.
     std::vector<int> all(block.images.size());
     std::iota(all.begin(), all.end(), 0);
-    GroupingPlan whole = *plan;
-    whole.strips = {all};
-    whole.groups.clear();
-    PlanStrips(block, o, fp, &whole);
-    plan->groups = std::move(whole.groups);
-    for (ImageGroup& g : plan->groups) g.strip = -1;
+    CutStrip(block, o, all, -1, plan);
+    for (ImageGroup& g : plan->groups) g.center = MeanCenter(fp, g.images);
     return;
   }
   for (ImageGroup& g : plan->groups) g.center = MeanCenter(fp, g.images);
-  for (const int i : singles) {
+  std::vector<int> joining;
+  std::vector<bool> as_image;
+  for (const size_t s : short_strips) {
+    const std::vector<int>& strip = plan->strips[s];
+    const Eigen::Vector2d c = MeanCenter(fp, strip);
     std::vector<size_t> order(plan->groups.size());
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      return (plan->groups[a].center - fp[i].center).squaredNorm() <
-             (plan->groups[b].center - fp[i].center).squaredNorm();
+      return (plan->groups[a].center - c).squaredNorm() <
+             (plan->groups[b].center - c).squaredNorm();
     });
-    bool joined = false;
+    bool placed = false;
     for (const size_t gi : order) {
       ImageGroup& g = plan->groups[gi];
       std::vector<int> with = g.images;
-      with.push_back(i);
+      with.insert(with.end(), strip.begin(), strip.end());
       if (static_cast<int>(with.size()) > o.max_images || !Fits(block, with, *plan)) continue;
       g.images = std::move(with);
       g.center = MeanCenter(fp, g.images);
-      joined = true;
+      placed = true;
       break;
     }
-    if (!joined) plan->ungrouped.push_back(i);
-  }
-}
-
-// Strip groups: up to strip_views images of other strips per group, as
-// views only, those that see most of the group's footprints first (summed
-// OverlapShare, each at least 10 % of one group image), while the group fits
-// the budget. Views are re-ranked per image when matching (SelectViews), so
-// more than kMaxViews - 1 here only helps where images see different ground.
-void AddStripViews(const Block& block, const GroupingOptions& o, const std::vector<Footprint>& fp,
-                   GroupingPlan* plan) {
-  if (o.strip_views <= 0) return;
-  std::vector<int> strip_of(block.images.size(), -1);
-  for (size_t s = 0; s < plan->strips.size(); ++s)
-    for (const int i : plan->strips[s]) strip_of[i] = static_cast<int>(s);
-  for (ImageGroup& g : plan->groups) {
-    if (g.strip < 0) continue;
-    std::vector<std::pair<double, int>> ranked;
-    for (size_t j = 0; j < block.images.size(); ++j) {
-      if (!fp[j].valid || strip_of[j] == g.strip ||
-          std::find(g.images.begin(), g.images.end(), static_cast<int>(j)) != g.images.end()) {
-        continue;
-      }
-      double sum = 0, best = 0;
-      for (const int i : g.images) {
-        // Disjoint bounding boxes: no overlap, without the 7 x 7 samples.
-        if (!fp[i].valid || (fp[i].hi.array() < fp[j].lo.array()).any() ||
-            (fp[j].hi.array() < fp[i].lo.array()).any()) {
-          continue;
-        }
-        const double share = OverlapShare(fp, i, static_cast<int>(j));
-        sum += share;
-        best = std::max(best, share);
-      }
-      if (best >= 0.1) ranked.emplace_back(sum, static_cast<int>(j));
+    if (!placed && static_cast<int>(strip.size()) >= std::max(2, plan->matcher.min_image_num) &&
+        Fits(block, strip, *plan)) {
+      ImageGroup g;
+      g.images = strip;
+      g.strip = static_cast<int>(s);
+      g.center = c;
+      plan->groups.push_back(std::move(g));
+      placed = true;
     }
-    std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
-      return a.first != b.first ? a.first > b.first : a.second < b.second;
-    });
-    std::vector<int> with = g.images;
-    for (const auto& [share, j] : ranked) {
-      if (static_cast<int>(g.views.size()) >= o.strip_views) break;
-      with.push_back(j);
-      if (!Fits(block, with, *plan)) {
-        with.pop_back();
-        break;
-      }
-      g.views.push_back(j);
+    for (const int i : strip) {
+      if (placed) break;
+      joining.push_back(i);
+      as_image.push_back(true);
     }
   }
+  for (const StripOutlier& out : plan->outliers) {
+    joining.push_back(out.image);
+    as_image.push_back(out.kind != OutlierKind::kClimb);
+  }
+  plan->ungrouped = JoinBestGroup(block, fp, joining, as_image, plan);
 }
 
 // Every tile costs kTileSamples^2 point-in-quad tests per image, so a tiny
@@ -457,8 +362,13 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
       tiles_in_group.push_back(1);
     }
   }
+  // An image no tile chose (its ground better seen by others, or no ground
+  // at all) still joins the group that sees it best, so that no image is
+  // left out of the plan.
+  std::vector<int> unused;
   for (size_t i = 0; i < used.size(); ++i)
-    if (!used[i]) plan->ungrouped.push_back(static_cast<int>(i));
+    if (!used[i]) unused.push_back(static_cast<int>(i));
+  plan->ungrouped = JoinBestGroup(block, fp, unused, std::vector<bool>(unused.size(), true), plan);
 }
 
 }  // namespace
@@ -537,11 +447,13 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   plan.strategy = options.strategy;
   plan.options = options;
   plan.matcher = matcher;
-  plan.strips = DetectStrips(block);
   const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
   if (const std::string reason = NoSurfaceReason(block, geometry); !reason.empty()) {
     throw Error(reason);
   }
+  StripDetection strips = DetectStrips(block, &geometry);
+  plan.strips = std::move(strips.strips);
+  plan.outliers = std::move(strips.outliers);
   const std::vector<Footprint> fp = Footprints(block, geometry);
   // The strategy's plan first, even for a block that is then kept whole: its
   // checks (tile cost, a block that does not look down) are the options'.
@@ -564,6 +476,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     return plan;
   }
   if (options.strategy == GroupingStrategy::kStrip) AddStripViews(block, options, fp, &plan);
+  AddAngleViews(block, fp, &plan);
   for (ImageGroup& g : plan.groups) {
     const std::vector<int> matched_in = g.MatchedIn();
     g.memory = EstimateInProcess(block, matched_in, matcher, process_bytes);

@@ -33,6 +33,19 @@ std::string NamesColumn(const Block& block, const std::vector<int>& ids) {
   return s;
 }
 
+// Where an image that joined a group went: "group 3" or "group 3 (view)",
+// "" when in none.
+std::string JoinedAs(const GroupingPlan& plan, int i) {
+  for (size_t g = 0; g < plan.groups.size(); ++g) {
+    const ImageGroup& grp = plan.groups[g];
+    if (std::find(grp.images.begin(), grp.images.end(), i) != grp.images.end())
+      return "group " + std::to_string(g + 1);
+    if (std::find(grp.views.begin(), grp.views.end(), i) != grp.views.end())
+      return "group " + std::to_string(g + 1) + " (view)";
+  }
+  return "";
+}
+
 }  // namespace
 
 void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) {
@@ -41,7 +54,14 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
       << block.images.size() << " images\n";
   out << "strips      " << plan.strips.size() << ":";
   for (const auto& s : plan.strips) out << " " << s.size();
-  out << " images\n";
+  out << " images";
+  if (!plan.outliers.empty()) out << ", " << plan.outliers.size() << " outliers";
+  out << "\n";
+  for (const StripOutlier& o : plan.outliers) {
+    const std::string joined = JoinedAs(plan, o.image);
+    out << "outlier     " << block.images[o.image].name << " " << o.reason << "; "
+        << (joined.empty() ? "in no group" : "joins " + joined) << "\n";
+  }
   out << "strategy    " << ToString(plan.strategy) << ": at most " << o.max_images
       << " images per group, level " << plan.matcher.level << ", memory budget "
       << FormatBytes(o.memory_budget);
@@ -124,6 +144,15 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
                   {"min_image_num", plan.matcher.min_image_num}};
   j["strips"] = json::array();
   for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
+  j["outliers"] = json::array();
+  for (const StripOutlier& out : plan.outliers) {
+    const std::string joined = JoinedAs(plan, out.image);
+    j["outliers"].push_back({{"index", out.image},
+                             {"name", block.images[out.image].name},
+                             {"kind", ToString(out.kind)},
+                             {"reason", out.reason},
+                             {"joins", joined.empty() ? json(nullptr) : json(joined)}});
+  }
   j["groups"] = json::array();
   for (const ImageGroup& g : plan.groups) {
     json jg = {{"indices", g.images},

@@ -4,7 +4,8 @@
 // independently and merged. Two strategies:
 //   strip      (paper) runs of at most max_images consecutive images within
 //              one flight strip, the last run of a strip taking the
-//              remainder (16 -> 6+6+4, 17 -> 6+6+5: the paper's Table 3);
+//              remainder (16 -> 6+6+4, 17 -> 6+6+5: the paper's Table 3)
+//              when it has 4 or more;
 //   footprint  (ours) the ground extent is tiled and each tile gets the
 //              images that see it best, across strips, so that side overlap
 //              also contributes views.
@@ -72,8 +73,9 @@ struct ImageGroup {
   std::vector<int> images;  // indices into block.images, in flight order (strip)
                             // or best view first (footprint)
   int strip = -1;           // strip index (strip strategy), else -1
-  // Images of other strips the group's patches are also matched in, never as
-  // a reference (GroupingOptions::strip_views), most overlap first.
+  // Images the group's patches are also matched in, never as a reference:
+  // outliers that joined it, images of other strips (GroupingOptions::
+  // strip_views, most overlap first), views that widen its angles.
   std::vector<int> views;
   // images, then views: every image the group loads and matches in.
   std::vector<int> MatchedIn() const {
@@ -94,6 +96,23 @@ struct ImageGroup {
   std::vector<int> short_of_views;
 };
 
+// An image that belongs to no flight strip (DetectStrips), and why. It still
+// joins the group whose ground it sees best (PlanGroups), as an image or,
+// when that group is full or the image sees the ground at another scale, as
+// a view.
+enum class OutlierKind {
+  kClimb,  // height above the ground far from the strips' (climb, descent)
+  kTurn,   // between two strips, off both (a turn, a side step)
+  kStray,  // before the first strip or after the last, off both
+};
+std::string ToString(OutlierKind kind);  // "climb", "turn", "stray"
+
+struct StripOutlier {
+  int image = -1;
+  OutlierKind kind = OutlierKind::kStray;
+  std::string reason;  // for people: what sets it apart, with the numbers
+};
+
 struct GroupingPlan {
   GroupingStrategy strategy = GroupingStrategy::kStrip;
   GroupingOptions options;  // what the plan was made with
@@ -101,8 +120,9 @@ struct GroupingPlan {
   // memory estimate) and min_image_num (short runs, short_of_views).
   MatcherOptions matcher;
   std::vector<std::vector<int>> strips;  // detected strips, images in flight order
+  std::vector<StripOutlier> outliers;    // images of no strip, in flight order
   std::vector<ImageGroup> groups;
-  std::vector<int> ungrouped;  // images in no group (see PlanGroups)
+  std::vector<int> ungrouped;  // images in no group, as images or views (see PlanGroups)
   // The whole block is one group: it has at most max_images images and fits
   // memory_budget, and splitting it would only lose views.
   bool single_group = false;
@@ -113,14 +133,19 @@ struct GroupingPlan {
 
 // Plans the groups of `block`. A block of at most max_images images whose
 // estimate fits memory_budget is one group (single_group), whatever the
-// strategy: `plan` and `run` both show what this returns. Strip strategy: a strip of one image
-// joins the group nearest to it that has room, else it is left ungrouped; a run of one image left
-// at the end of a strip takes one image from the run before it (or shares it, when max_images is
-// 2), so no group has a single image; a block with no strip of 2 or more images (terrestrial,
-// convergent) is cut in block order as one strip, its groups with strip -1. Footprint strategy:
-// images without a surface estimate, or seen in no kept tile, are ungrouped. Throws sapmvs::Error
-// for bad options, a block of fewer than 2 images, and when min_image_num images (at least 2)
-// do not fit memory_budget.
+// strategy: `plan` and `run` both show what this returns. Strip strategy:
+// strips follow the flight (DetectStrips); a strip's last run under 4
+// images moves the cuts back (13 -> 5+4+4) where the strip has the images,
+// a strip under 4 images joins the nearest group with room, and the images
+// of no strip (outliers: climb, turns) join the group that sees them best,
+// as images or as views; a block with no strip of 4 or more images
+// (terrestrial, convergent) is cut in block order as one strip, its groups
+// with strip -1. Footprint strategy: images no tile chose join the group
+// that sees them best. Either way every group then takes views from beyond
+// it until some pair it matches in meets at its ground at 2 max_angle_deg,
+// and `ungrouped` holds only images that fit in no group's budget. Throws
+// sapmvs::Error for bad options, a block of fewer than 2 images, and when
+// min_image_num images (at least 2) do not fit memory_budget.
 // `matcher`: the options the groups will be matched with. Its level, cell
 // size and wave size set the memory estimate; a strip run shorter than its
 // min_image_num takes the strip images before it, and images of a group that
