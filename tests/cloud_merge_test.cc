@@ -117,13 +117,40 @@ TEST(CloudMerge, AHoleInTheOwnerIsFilledByTheOtherGroup) {
   std::vector<GroupCloud> groups = {{&a, {500000.0, 5400005.0}}, {&b, {500040.0, 5400005.0}}};
   MergeOptions o;
   o.radius = s;
-  const PointCloud m = MergeGroupClouds(groups, o);
-  long in_hole = 0;
-  for (const CloudPoint& p : m.points) {
-    const double x = p.position.x() - 500000.0, y = p.position.y() - 5400000.0;
-    if (x >= 14.6 && x < 17.4 && y >= 2.6 && y < 5.4) ++in_hole;
-  }
-  EXPECT_GE(in_hole, 5 * 5);  // b's grid points well inside the hole
+  auto in_hole = [](const PointCloud& m, double inset) {
+    long n = 0;
+    for (const CloudPoint& p : m.points) {
+      const double x = p.position.x() - 500000.0, y = p.position.y() - 5400000.0;
+      if (x >= 14 + inset && x < 18 - inset && y >= 2 + inset && y < 6 - inset) ++n;
+    }
+    return n;
+  };
+  // b's points more than outside_core_radii radii from a's fill the hole:
+  // at x and y 15.1, 15.6 and 16.1 by default (3 radii: 1.5 from a's rim at
+  // 13.5 and 18, 0.5 and 6).
+  EXPECT_EQ(in_hole(MergeGroupClouds(groups, o), 0), 3 * 3);
+  o.outside_core_radii = 1;
+  EXPECT_GE(in_hole(MergeGroupClouds(groups, o), 0.6), 5 * 5);
+}
+
+TEST(CloudMerge, AnotherGroupsLayerJustOffTheOwnersSurfaceIsNotStacked) {
+  // With real orientations two groups place the same ground a little apart:
+  // b's points lie between a's, 0.8 spacings higher, 1.07 spacings from
+  // the nearest of a's. Over a's core they are another layer of a's surface.
+  const double s = 0.5;
+  const PointCloud a = Grid(0, 20, 0, 10, s, 0, 0, 100, 0.5f);
+  const PointCloud b = Grid(0, 20, 0, 10, s, s / 2, s / 2, 100 + 0.8 * s, 0.9f);
+  std::vector<GroupCloud> groups = {{&a, {500000.0, 5400005.0}}, {&b, {500040.0, 5400005.0}}};
+  MergeOptions o;
+  o.radius = s;
+  MergeStats st;
+  MergeGroupClouds(groups, o, &st);
+  EXPECT_EQ(st.kept_by_group[0], static_cast<long>(a.points.size()));
+  EXPECT_EQ(st.kept_by_group[1], 0);
+  // At one radius, as the merge judged every point, b's layer stayed.
+  o.outside_core_radii = 1;
+  MergeGroupClouds(groups, o, &st);
+  EXPECT_EQ(st.kept_by_group[1], static_cast<long>(b.points.size()));
 }
 
 TEST(CloudMerge, SurfacesAtOtherHeightsAreNotDuplicates) {
@@ -162,7 +189,8 @@ TEST(CloudMerge, SameInputsGiveTheSameOutput) {
 }
 
 // The merge keeps, in order of core first and then score, each point with
-// no kept point of another group within the radius. Checked pair by pair
+// no kept point of another group within the radius (outside_core_radii
+// radii for a point outside its core). Checked pair by pair
 // against every kept point on three groups: two that overlap in a band and
 // one apart, whose points the merge keeps without looking them up.
 TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
@@ -185,6 +213,7 @@ TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
   }
   MergeOptions o;
   o.radius = 0.3;
+  o.outside_core_radii = 2.5;
   MergeStats stats;
   const std::vector<MergedRef> merged = MergeGroupRefs(groups, o, &stats);
 
@@ -209,9 +238,10 @@ TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
   std::vector<Item> kept;
   for (const Item& item : items) {
     const Eigen::Vector3d& p = clouds[item.group].points[item.index].position;
+    const double r = item.core ? o.radius : o.radius * o.outside_core_radii;
     const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Item& k) {
       return k.group != item.group &&
-             (clouds[k.group].points[k.index].position - p).squaredNorm() <= o.radius * o.radius;
+             (clouds[k.group].points[k.index].position - p).squaredNorm() <= r * r;
     });
     if (!duplicate) kept.push_back(item);
   }
@@ -237,6 +267,13 @@ TEST(CloudMerge, BadRadiusIsAnError) {
     o.radius = r;
     EXPECT_THROW(MergeGroupClouds(groups, o), Error) << r;
   }
+  o.radius = 1;
+  for (const double k : {0.99, std::nan("")}) {
+    o.outside_core_radii = k;
+    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
+  }
+  o.outside_core_radii = 1;
+  EXPECT_NO_THROW(MergeGroupClouds(groups, o));
 }
 
 TEST(CloudMerge, CoreOwnerIsTheNearestCentre) {

@@ -433,3 +433,54 @@ TEST(Propagator, APmvsPassGrowsInItsViewsAtEveryWave) {
 
 }  // namespace
 }  // namespace sapmvs
+
+namespace sapmvs {
+namespace {
+
+// A group that owns part of the ground grows only there: seeds and
+// candidates whose centres lie outside its region are not tried, so no
+// patch centre lies outside it (but for the refinement's move along its
+// ray, a few centimetres here), while without a region the same seeds
+// cover both sides. The region's edge runs through the middle of image 0's
+// ground, in the block's world frame (the group's origin added).
+TEST(Propagator, GrowsOnlyOnTheGroundItOwns) {
+  test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
+  MatchGroupData group = GroupWithGrey(scene);
+  group.origin = Eigen::Vector3d(500000, 5400000, 200);
+  const std::vector<SeedFeature> seeds = SeedsInImage0(scene, 12);
+  const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
+  MatcherOptions options;
+  options.max_angle_deg = 5.0;  // the cameras are a few metres apart at 40 m
+  options.max_waves = 6;
+  const Eigen::Vector3d middle = test::GroundAt(scene.cameras[0], {60, 48});
+  const double x0 = group.origin.x() + middle.x();
+  auto run = [&](const GroundRegion& region, long* left, long* right) {
+    PatchEngine engine(*kernels, group, options);
+    Propagator propagator(group, options, engine);
+    propagator.SetRegion(region);
+    propagator.RunSeeds(seeds);
+    propagator.RunWaves({});
+    *left = *right = 0;
+    for (const AcceptedPatch& p : propagator.patches()) {
+      const double x = group.origin.x() + p.center.x();
+      *left += x < x0 - 0.1;
+      *right += x > x0 + 0.1;
+    }
+  };
+  long left = 0, right = 0;
+  run(GroundRegion(), &left, &right);
+  ASSERT_GT(left, 10);
+  ASSERT_GT(right, 10);
+  // Two centres 20 m either side of x0: the first owns x <= x0.
+  const std::vector<Eigen::Vector2d> centers = {{x0 - 20, group.origin.y()},
+                                                {x0 + 20, group.origin.y()}};
+  run(GroundRegion(centers, 0, 0), &left, &right);
+  EXPECT_GT(left, 10);
+  EXPECT_EQ(right, 0);
+  run(GroundRegion(centers, 1, 0), &left, &right);
+  EXPECT_EQ(left, 0);
+  EXPECT_GT(right, 10);
+}
+
+}  // namespace
+}  // namespace sapmvs

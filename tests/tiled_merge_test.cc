@@ -138,6 +138,10 @@ TEST(TiledMergeTest, ManyTilesDifferOnlyNearBorders) {
   MergeOptions o;
   o.radius = 0.5;
   o.tile_points = 8000;  // tiles of about 15 m: dozens, every group cut
+  // A halo of 8 radii, as measured below, for the points outside their
+  // cores that are judged at 3.
+  o.outside_core_radii = 3;
+  o.halo_radii = 8.0 / 3;
   MergeStats global_stats, tiled_stats;
   MergeLayout layout;
   const PointCloud global = GlobalMerge(b, o, &global_stats);

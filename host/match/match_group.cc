@@ -91,7 +91,7 @@ MatcherMemoryModel MatcherMemory() {
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, PatchKernels& kernels,
                        const BlockGeometry* geometry, const MatchProgressFn& on_progress,
-                       const std::vector<int>& view_ids) {
+                       const std::vector<int>& view_ids, const GroundRegion& region) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("matcher options: expected " + problem);
   std::vector<int> ids = image_ids;
@@ -198,6 +198,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   PatchEngine engine(kernels, group, options);
   engines.push_back(&engine);
   Propagator propagator(group, options, engine);
+  propagator.SetRegion(region);
   propagator.RunSeeds(seeds, [&](long rank, long ranks, long accepted) {
     report("seeds", rank, ranks, std::to_string(accepted) + " accepted");
   });

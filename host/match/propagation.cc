@@ -221,7 +221,7 @@ void Propagator::Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
   const int cell = grid.Index(q, options_.cell_size);
   if (cell < 0 || grid.owner[cell] != -1 || grid.tries[cell] >= kMaxCellTries) return;
   const Eigen::Vector3d c = IntersectPlane(cam, q, patch.center, patch.normal);
-  if (!c.allFinite()) return;
+  if (!c.allFinite() || !InRegion(c)) return;
   ++grid.tries[cell];
   PatchCandidate cand;
   cand.center = c;
@@ -364,6 +364,7 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
       if (done[s] || rank >= static_cast<int>(seeds[s].candidates.size())) continue;
       const int cell = grids_[seeds[s].image].Index(seeds[s].uv, cs);
       if (cell < 0 || grids_[seeds[s].image].owner[cell] != -1) continue;
+      if (!InRegion(seeds[s].candidates[rank].center)) continue;
       batch.push_back(seeds[s].candidates[rank]);
       which.push_back(static_cast<int>(s));
     }

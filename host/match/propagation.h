@@ -24,6 +24,7 @@
 #include "match/group_data.h"
 #include "match/patch_engine.h"
 #include "match/seed_matcher.h"
+#include "sapmvs/match/ground_region.h"
 
 namespace sapmvs {
 
@@ -51,6 +52,9 @@ class Propagator {
   // `on_rank(rank, ranks, accepted)` after each rank of candidates is scored.
   void RunSeeds(const std::vector<SeedFeature>& seeds,
                 const std::function<void(long, long, long)>& on_rank = {});
+  // The ground the group owns: no seed or candidate whose centre lies
+  // outside it is tried, so no patch grows there. Everything by default.
+  void SetRegion(const GroundRegion& region) { region_ = region; }
   // Edge barriers for the flood fill (sapmvs mode); one map per image.
   void SetEdges(std::vector<EdgeMap> edges) { edges_ = std::move(edges); }
   // Waves until the front is empty (or max_waves). `on_wave` (may be empty)
@@ -140,6 +144,10 @@ class Propagator {
   // Frees the cells point d owns, in its reference and its patch's views.
   void Release(const DensePoint& d);
   bool IsBarrier(int image, int x, int y, const AcceptedPatch& patch) const;
+  // Whether local-frame point x lies on the group's own ground.
+  bool InRegion(const Eigen::Vector3d& x) const {
+    return region_.Unbounded() || region_.Contains((x + group_.origin).head<2>());
+  }
   // Accepts the evaluated candidates best score first; returns accepted indices.
   std::vector<int> AcceptBatch(std::vector<std::optional<AcceptedPatch>>& results);
 
@@ -149,6 +157,7 @@ class Propagator {
   bool grows_as_pmvs_ = false;
   std::vector<Grid> grids_;
   std::vector<EdgeMap> edges_;
+  GroundRegion region_;
   std::vector<AcceptedPatch> patches_;
   std::vector<DensePoint> points_;
   std::vector<PatchCandidate> front_;

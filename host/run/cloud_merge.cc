@@ -17,6 +17,18 @@ std::string MergeOptions::Problem() const {
     s << "a merge radius finite and > 0 (radius = " << radius << ")";
     return s.str();
   }
+  if (!(std::isfinite(outside_core_radii) && outside_core_radii >= 1)) {
+    std::ostringstream s;
+    s << "an outside-core radius >= 1 radius (outside_core_radii = " << outside_core_radii << ")";
+    return s.str();
+  }
+  if (!(std::isfinite(seam_feather_radii) && seam_feather_radii >= 0) ||
+      !(std::isfinite(seam_band_radii) && seam_band_radii > 0)) {
+    std::ostringstream s;
+    s << "a seam feather >= 0 and a seam band > 0 (seam_feather_radii = " << seam_feather_radii
+      << ", seam_band_radii = " << seam_band_radii << ")";
+    return s.str();
+  }
   if (tile_points < 1000)
     return "merge tile points >= 1000 (tile_points = " + std::to_string(tile_points) + ")";
   if (!(std::isfinite(halo_radii) && halo_radii >= 1)) {
@@ -208,7 +220,8 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     bool contested;  // MayHaveForeignNeighbour
     float score;
   };
-  const std::vector<uint8_t> contested = MayHaveForeignNeighbour(groups, options.radius);
+  const double wide = options.radius * options.outside_core_radii;
+  const std::vector<uint8_t> contested = MayHaveForeignNeighbour(groups, wide);
   std::vector<Item> items(contested.size());
   size_t flat = 0;
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -229,15 +242,18 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     return a.score > b.score;
   });
 
-  const double r2 = options.radius * options.radius;
   auto point = [&](const Ref& ref) -> const CloudPoint& {
     return groups[ref.group].cloud->points[ref.index];
   };
-  RadiusGrid<Ref> kept(options.radius);
+  // Core points are looked up within the radius, the others within `wide`,
+  // each in a grid of its own reach (RadiusGrid looks one cube around).
+  RadiusGrid<Ref> kept(options.radius), kept_wide(wide);
   for (const Item& item : items) {
     if (item.contested) {
       const Eigen::Vector3d& p = point(item.ref).position;
-      const bool duplicate = kept.AnyNear(p, [&](const Ref& other) {
+      const double r = item.core ? options.radius : wide;
+      const double r2 = r * r;
+      const bool duplicate = (item.core ? kept : kept_wide).AnyNear(p, [&](const Ref& other) {
         return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
       });
       if (duplicate) {
@@ -245,6 +261,7 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
         continue;
       }
       kept.Insert(p, item.ref);
+      kept_wide.Insert(p, item.ref);
     }
     order.push_back({item.ref.group, item.ref.index, item.core});
     ++st.kept_by_group[item.ref.group];

@@ -166,8 +166,10 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
                                             std::vector<std::filesystem::path>{"groups"});
     if (options.restart) RemoveRunOutputs(options.out);
   }
-  RunCheckpoints checkpoints(options.out / "groups", block, plan, options.matcher,
-                             options.restart && dispatch.merges());
+  const bool owns_ground = plan.groups.size() > 1 && !options.share_ground;
+  RunCheckpoints checkpoints(
+      options.out / "groups", block, plan, options.matcher, options.restart && dispatch.merges(),
+      owns_ground ? std::optional<double>(options.own_margin_gsd) : std::nullopt);
   dispatch.Open(options.out / "groups");
   report.ranks = dispatch.session().size();
   report.rank = dispatch.session().rank();
@@ -185,6 +187,10 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     images_to_match += static_cast<long>(plan.groups[g].images.size());
   }
   RunProgress progress(to_match, images_to_match, show);
+  std::vector<Eigen::Vector2d> centers;
+  for (const ImageGroup& group : plan.groups)
+    centers.push_back(group.center + block.origin.head<2>());
+  const double level_gsd = geometry.gsd_median * std::ldexp(1.0, options.matcher.level);
   int matched_now = 0;
   bool stopped = false;  // groups left for a later call (max_groups)
   for (int g = 0; g < n; ++g) {
@@ -215,7 +221,9 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     kernels->ResetPeakDeviceBytes();
     MatchResult result = MatchGroup(
         block, plan.groups[g].images, options.matcher, *kernels, &geometry,
-        [&](const MatchProgressEvent& e) { progress.Update(e); }, plan.groups[g].views);
+        [&](const MatchProgressEvent& e) { progress.Update(e); }, plan.groups[g].views,
+        owns_ground ? GroundRegion(centers, g, options.own_margin_gsd * level_gsd)
+                    : GroundRegion());
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
     run.memory.peak_rss_bytes = PeakRssBytes();
@@ -258,10 +266,13 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     job.groups.push_back({[&checkpoints, g](const PointFilter& keep) {
                             return ReadPly(checkpoints.CloudPath(g), keep);
                           },
-                          plan.groups[g].center + block.origin.head<2>()});
+                          centers[g]});
   }
-  job.merge.radius =
-      options.merge_radius_gsd * geometry.gsd_median * std::ldexp(1.0, options.matcher.level);
+  job.merge.radius = options.merge_radius_gsd * level_gsd;
+  // In radii: the heights are compared where both groups matched, within
+  // their margin of the border.
+  job.merge.seam_feather_radii = options.seam_feather_gsd / options.merge_radius_gsd;
+  job.merge.seam_band_radii = std::max(options.own_margin_gsd, 1.0) / options.merge_radius_gsd;
   job.merge.tile_points = options.merge_tile_points;
   job.dsm = options.dsm;
   job.las.version = options.las_version;

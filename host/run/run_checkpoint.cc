@@ -24,7 +24,7 @@ nlohmann::json ReadJson(const std::filesystem::path& path) {
 }
 
 nlohmann::json PlanRecord(const Block& block, const GroupingPlan& plan,
-                          const MatcherOptions& matcher) {
+                          const MatcherOptions& matcher, std::optional<double> own_margin_gsd) {
   nlohmann::json groups = nlohmann::json::array(), views = nlohmann::json::array();
   auto names = [&](const std::vector<int>& ids) {
     nlohmann::json n = nlohmann::json::array();
@@ -35,7 +35,11 @@ nlohmann::json PlanRecord(const Block& block, const GroupingPlan& plan,
     groups.push_back(names(g.images));
     views.push_back(names(g.views));
   }
-  return {{"groups", groups}, {"views", views}, {"matcher", OptionsJson(matcher)}};
+  nlohmann::json record = {{"groups", groups}, {"views", views}, {"matcher", OptionsJson(matcher)}};
+  // Absent when every group matched all its ground, so that such a run's
+  // plan.json reads as before.
+  if (own_margin_gsd) record["own_margin_gsd"] = *own_margin_gsd;
+  return record;
 }
 
 // group_NNN.ply or group_NNN.json, as CloudPath/StatusPath name them.
@@ -73,13 +77,13 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
 
 RunCheckpoints::RunCheckpoints(std::filesystem::path dir, const Block& block,
                                const GroupingPlan& plan, const MatcherOptions& matcher,
-                               bool restart)
+                               bool restart, std::optional<double> own_margin_gsd)
     : dir_(std::move(dir)) {
   std::error_code ec;
   if (restart) RemoveCheckpoints(dir_);
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw Error(dir_.string() + ": cannot create the checkpoint folder: " + ec.message());
-  const nlohmann::json record = PlanRecord(block, plan, matcher);
+  const nlohmann::json record = PlanRecord(block, plan, matcher, own_margin_gsd);
   const std::filesystem::path plan_path = dir_ / "plan.json";
   if (std::filesystem::exists(plan_path)) {
     if (ReadJson(plan_path) != record) {

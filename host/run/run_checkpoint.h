@@ -6,6 +6,7 @@
 // with the same plan resumes; one with another plan or other options is
 // refused rather than mixing clouds matched differently.
 #include <filesystem>
+#include <optional>
 
 #include "sapmvs/block/block.h"
 #include "sapmvs/io/ply_io.h"
@@ -34,8 +35,11 @@ class RunCheckpoints {
   // Creates `dir`; with `restart` removes the checkpoints an earlier run left
   // there (RemoveCheckpoints).
   // Throws Error naming plan.json when it records another plan or options.
+  // `own_margin_gsd`: each group matched its own ground and this margin
+  // (RunOptions::own_margin_gsd); none when every group matched all of it.
   RunCheckpoints(std::filesystem::path dir, const Block& block, const GroupingPlan& plan,
-                 const MatcherOptions& matcher, bool restart);
+                 const MatcherOptions& matcher, bool restart,
+                 std::optional<double> own_margin_gsd = std::nullopt);
 
   bool Done(int group) const;
   GroupCheckpoint Read(int group) const;

@@ -157,6 +157,8 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["merge"] = {{"input", report.merge.input},
                 {"kept", report.merge.kept},
                 {"cross_group_duplicates", report.merge.duplicates},
+                {"seams_levelled", report.merge.seam_pairs},
+                {"seam_offset", report.merge.seam_offset},
                 {"tiles", report.merge_tiles}};
   // Matching stages (summed over the groups matched in this call, with their
   // device time), then the run's own: plan, match (all groups), merge, ...

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
+#include "sapmvs/run/seam_leveling.h"
 #include "sapmvs/util/error.h"
 
 namespace sapmvs {
@@ -59,12 +61,28 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
   // once; past that, one group is in memory at a time.
   std::vector<Box> extent(n);
   Box block;
+  // Seams are measured in this first pass and levelled as the tiles load.
+  std::optional<SeamLeveling> seams;
+  if (options.seam_feather_radii > 0 && n > 1) {
+    std::vector<Eigen::Vector2d> centers;
+    for (const MergeSource& g : groups) centers.push_back(g.center);
+    SeamOptions so;
+    so.cell = 2 * options.radius;
+    so.band = options.seam_band_radii * options.radius;
+    so.feather = options.seam_feather_radii * options.radius;
+    // Two radii: groups that disagree by their orientations differ by a
+    // fraction of a pixel (the Caliterra flight's stretches: a median 1.4
+    // cm at 6.9 cm GSD).
+    so.max_offset = 2 * options.radius;
+    seams.emplace(std::move(centers), so);
+  }
   std::vector<PointCloud> read(n);
   bool all_read = true;
   for (size_t g = 0; g < n; ++g) {
     long count = 0;
     PointCloud c = groups[g].load([&](const Eigen::Vector3d& p) {
       extent[g].Add(p.x(), p.y());
+      if (seams) seams->Add(static_cast<int>(g), p);
       ++count;
       return all_read && layout.input_points + count <= options.tile_points;
     });
@@ -81,11 +99,18 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
       read = std::vector<PointCloud>(n);
     }
   }
+  if (seams) {
+    seams->Finish();
+    st.seam_pairs = seams->pairs();
+    st.seam_offset = seams->median_offset();
+    if (seams->pairs() == 0) seams.reset();
+  }
   if (layout.input_points == 0) {
     if (layout_out) *layout_out = layout;
     return st;
   }
-  const double halo = options.halo_radii * options.radius;
+  // In the radii a point outside its core is judged by.
+  const double halo = options.halo_radii * options.radius * options.outside_core_radii;
   layout.tiles_x = layout.tiles_y = 1;
   if (layout.input_points > options.tile_points) {
     // Square tiles of about tile_points each at the block's mean density,
@@ -130,6 +155,11 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
         } else {
           clouds[g] =
               groups[g].load([&](const Eigen::Vector3d& p) { return reach.Holds(p.x(), p.y()); });
+        }
+        if (seams) {
+          for (CloudPoint& p : clouds[g].points) {
+            p.position.z() += seams->Correction(static_cast<int>(g), p.position);
+          }
         }
       }
       MergeStats tile_stats;

@@ -13,6 +13,7 @@
 
 #include "sapmvs/block/block.h"
 #include "sapmvs/io/ply_io.h"
+#include "sapmvs/match/ground_region.h"
 #include "sapmvs/match/match_stats.h"
 #include "sapmvs/match/matcher_options.h"
 #include "sapmvs/util/match_progress.h"
@@ -33,13 +34,15 @@ struct MatchResult {
 // patch's reference (ImageGroup::views). `geometry`:
 // EstimateBlockGeometry(block) when the caller already has it, else nullptr.
 // `on_progress` hears each stage and wave; without it, options.progress
-// draws a status line of its own on a terminal. Throws Error for bad
+// draws a status line of its own on a terminal. `region`: the ground the
+// group owns; no patch grows outside it. Throws Error for bad
 // options, unreadable images or fewer than 2 usable images.
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, PatchKernels& kernels,
                        const BlockGeometry* geometry = nullptr,
                        const MatchProgressFn& on_progress = {},
-                       const std::vector<int>& view_ids = {});
+                       const std::vector<int>& view_ids = {},
+                       const GroundRegion& region = GroundRegion());
 
 // What matching one group holds, per unit, for the planner's memory model
 // (grouping.h EstimateGroupMemory, which spells out each term): per pixel of

@@ -5,11 +5,13 @@
 //
 // Each group owns a core: the XY points nearer to its ground centre than to
 // any other group's (a Voronoi cell). Points are taken core points first,
-// then by score, best first; a point is dropped when a point already kept
-// from another group lies within `radius` of it (3D). Points of one group are
-// never dropped for each other, so a group's own density stays as matched;
-// a point outside its group's core survives where the owner matched nothing
-// nearby, so group borders get neither seams nor holes.
+// then by score, best first; a core point is dropped when a point already
+// kept from another group lies within `radius` of it (3D), a point outside
+// its group's core when one lies within outside_core_radii radii. Points of
+// one group are never dropped for each other, so a group's own density stays
+// as matched; a point outside its group's core survives only where the owner
+// matched nothing nearby, so group borders get neither seams nor holes, and
+// the owner's surface is not doubled by another group's a little off it.
 
 #include <Eigen/Core>
 #include <vector>
@@ -27,11 +29,25 @@ struct MergeOptions {
   // Duplicate distance, CRS units (> 0): the caller passes about one ground
   // sample distance of the level matched, the spacing of the emitted points.
   double radius = 0;
+  // A point outside its group's core is a duplicate of another group's
+  // point within this many radii (>= 1). With real orientations two groups
+  // place a surface a few centimetres apart: at 1 radius the other group's
+  // points between the owner's survived and stacked a second layer on its
+  // surface, which doubled the merged cloud's local noise.
+  double outside_core_radii = 3;
   // The tiled merge (tiled_merge.h): about this many group points per tile;
   // a block with no more than these is merged in one piece (>= 1000).
   long tile_points = 250000;  // RunOptions::merge_tile_points gives it
+  // The tiled merge levels the seams between groups before it merges them
+  // (seam_leveling.h): each group's heights meet its neighbour's at their
+  // border and fade to its own over this many radii. 0 = off.
+  double seam_feather_radii = 0;
+  // The heights of two groups are compared within this many radii of their
+  // border, where both matched (> 0).
+  double seam_band_radii = 4;
   // The tiled merge's halo: each tile is merged with the points within this
-  // many radii around it, and keeps only its own (>= 1).
+  // many times radius * outside_core_radii around it, and keeps only its own
+  // (>= 1).
   double halo_radii = 8;
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
@@ -43,6 +59,10 @@ struct MergeStats {
   long duplicates = 0;              // dropped: another group's point within radius
   std::vector<long> kept_by_group;  // in the order of the groups given
   std::vector<long> core_by_group;  // of those, inside the group's own core
+  // The tiled merge's seam levelling: borders measured, and the median
+  // |offset| of the stretches levelled (CRS units).
+  int seam_pairs = 0;
+  double seam_offset = 0;
 };
 
 // The merged cloud takes crs and the has_* flags from the first group (all

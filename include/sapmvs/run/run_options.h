@@ -36,6 +36,18 @@ struct RunOptions {
   // Match at most this many groups in this call, then stop (resumable);
   // 0 = all. For matching a long block over several calls.
   int max_groups = 0;
+  // Each group of several matches only the ground it owns (GroundRegion:
+  // nearer its centre than any other group's), widened by this many ground
+  // sample distances of the level matched, so that neighbours overlap where
+  // they meet. >= 0.
+  double own_margin_gsd = 4.0;
+  // Every group matches all the ground its images see, as the paper's
+  // groups did; the merge then keeps one of each pair of near points.
+  bool share_ground = false;
+  // The merge levels the seams between groups (seam_leveling.h): a group's
+  // heights meet its neighbour's at their border and fade back to its own
+  // over this many ground sample distances of the level matched. 0 = off.
+  double seam_feather_gsd = 20.0;
   // Merge: a point is a duplicate of another group's point within this many
   // ground sample distances of the matched level. > 0.
   double merge_radius_gsd = 1.0;
@@ -80,6 +92,25 @@ void VisitFields(RunOptions& o, F&& f) {
         .Unit("groups")
         .Range(AtLeast(0))
         .Help("Match at most this many groups now, then stop (resumable; 0 = all)"));
+  f(Field(o.own_margin_gsd, "own_margin_gsd")
+        .Flag("--own-margin")
+        .In("Merge and DSM")
+        .Unit("GSDs")
+        .Range(AtLeast(0))
+        .Help("Each group matches its own ground (nearer its centre than any other's) and "
+              "this many GSDs beyond it"));
+  f(Field(o.share_ground, "share_ground")
+        .Flag("--share-ground")
+        .In("Merge and DSM")
+        .Help("Every group matches all the ground its images see (the merge drops the "
+              "duplicates)"));
+  f(Field(o.seam_feather_gsd, "seam_feather_gsd")
+        .Flag("--seam-feather")
+        .In("Merge and DSM")
+        .Unit("GSDs")
+        .Range(AtLeast(0))
+        .Help("Merge: groups' heights meet at their borders and fade back over this many GSDs "
+              "(0 = off)"));
   f(Field(o.merge_radius_gsd, "merge_radius_gsd")
         .Flag("--merge-radius")
         .In("Merge and DSM")

@@ -60,6 +60,10 @@ using MergedTile = std::function<void(const PointCloud& tile, const MergeLayout&
 
 // Merges `groups` tile by tile, reading each group once to find its extent and
 // then once per tile it reaches, and hands each tile's kept points to `emit`.
+// With options.seam_feather_radii > 0 the first read also measures the
+// seams between the groups, and every group's points are levelled
+// (seam_leveling.h) as a tile loads them, before they are merged; the
+// heights then differ from MergeGroupClouds'.
 // The stats count each point once, in the tile it lies in. Throws
 // sapmvs::Error for bad options, or what `load` throws.
 MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptions& options,

@@ -1,0 +1,135 @@
+#include "sapmvs/run/seam_leveling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "sapmvs/util/error.h"
+
+namespace sapmvs {
+namespace {
+
+int64_t Floor(double v, double side) { return static_cast<int64_t>(std::floor(v / side)); }
+
+template <typename T>
+double Median(std::vector<T> v) {
+  const auto mid = v.begin() + static_cast<long>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return static_cast<double>(*mid);
+}
+
+}  // namespace
+
+std::string SeamOptions::Problem() const {
+  std::ostringstream s;
+  if (!(std::isfinite(cell) && cell > 0)) {
+    s << "a seam cell > 0 (cell = " << cell << ")";
+  } else if (!(std::isfinite(band) && band > 0)) {
+    s << "a seam band > 0 (band = " << band << ")";
+  } else if (!(std::isfinite(feather) && feather > 0)) {
+    s << "a seam feather > 0 (feather = " << feather << ")";
+  } else if (!(std::isfinite(max_offset) && max_offset > 0)) {
+    s << "a largest seam offset > 0 (max_offset = " << max_offset << ")";
+  }
+  return s.str();
+}
+
+SeamLeveling::SeamLeveling(std::vector<Eigen::Vector2d> centers, const SeamOptions& options)
+    : centers_(std::move(centers)), options_(options) {
+  if (const std::string p = options.Problem(); !p.empty()) throw Error("seams: expected " + p);
+}
+
+double SeamLeveling::Beyond(int g, int h, const Eigen::Vector2d& p) const {
+  const Eigen::Vector2d d = centers_[h] - centers_[g];
+  const double length = d.norm();
+  if (!(length > 0)) return std::numeric_limits<double>::infinity();
+  return ((p - centers_[h]).squaredNorm() - (p - centers_[g]).squaredNorm()) / (2 * length);
+}
+
+std::pair<int, int> SeamLeveling::TwoNearest(const Eigen::Vector2d& p) const {
+  int first = -1, second = -1;
+  double d1 = 0, d2 = 0;
+  for (int g = 0; g < static_cast<int>(centers_.size()); ++g) {
+    const double d = (p - centers_[g]).squaredNorm();
+    if (first < 0 || d < d1) {
+      second = first, d2 = d1;
+      first = g, d1 = d;
+    } else if (second < 0 || d < d2) {
+      second = g, d2 = d;
+    }
+  }
+  return {first, second};
+}
+
+void SeamLeveling::Add(int g, const Eigen::Vector3d& p) {
+  const Eigen::Vector2d xy = p.head<2>();
+  const auto [owner, next] = TwoNearest(xy);
+  if (next < 0) return;
+  // The border the point lies by: its owner's with the next nearest centre.
+  if (g != owner && g != next) return;
+  if (std::abs(Beyond(owner, next, xy)) > options_.band) return;
+  const int a = std::min(owner, next), b = std::max(owner, next);
+  heights_[{a, b, Floor(xy.x(), options_.cell), Floor(xy.y(), options_.cell), g == a ? 0 : 1}]
+      .push_back(static_cast<float>(p.z()));
+}
+
+void SeamLeveling::Finish() {
+  std::map<std::tuple<int, int, int64_t, int64_t>, std::vector<double>> stretches;
+  std::map<std::pair<int, int>, std::vector<double>> pairs;
+  for (auto it = heights_.begin(); it != heights_.end(); ++it) {
+    const auto& [a, b, x, y, side] = it->first;
+    if (side != 0) continue;
+    const auto other = heights_.find({a, b, x, y, 1});
+    if (other == heights_.end()) continue;
+    const double d = Median(it->second) - Median(other->second);
+    // The cell's centre names the stretch it lies in.
+    const double cx = (x + 0.5) * options_.cell, cy = (y + 0.5) * options_.cell;
+    stretches[{a, b, Floor(cx, options_.feather), Floor(cy, options_.feather)}].push_back(d);
+    pairs[{a, b}].push_back(d);
+  }
+  heights_.clear();
+  // A stretch needs a few cells to say more than its noise.
+  constexpr size_t kMinCells = 5;
+  std::vector<double> levelled;
+  for (const auto& [key, ds] : stretches) {
+    if (ds.size() < kMinCells) continue;
+    const double d = Median(ds);
+    // NaN: measured and left alone, rather than given the border's offset.
+    const bool surface = std::abs(d) > options_.max_offset;
+    stretch_offset_[key] = surface ? std::numeric_limits<double>::quiet_NaN() : d;
+    if (!surface) levelled.push_back(std::abs(d));
+  }
+  for (const auto& [key, ds] : pairs) {
+    if (ds.size() < kMinCells) continue;
+    const double d = Median(ds);
+    pair_offset_[key] = std::abs(d) <= options_.max_offset ? d : 0.0;
+  }
+  median_offset_ = levelled.empty() ? 0 : Median(levelled);
+}
+
+double SeamLeveling::Correction(int g, const Eigen::Vector3d& p) const {
+  const Eigen::Vector2d xy = p.head<2>();
+  double dz = 0;
+  for (int h = 0; h < static_cast<int>(centers_.size()); ++h) {
+    if (h == g) continue;
+    const double t = Beyond(g, h, xy);
+    if (!(t < options_.feather)) continue;
+    const int a = std::min(g, h), b = std::max(g, h);
+    const auto whole = pair_offset_.find({a, b});
+    if (whole == pair_offset_.end()) continue;
+    // The offset of the stretch where the point's way to the border meets it.
+    const Eigen::Vector2d u = (centers_[h] - centers_[g]).normalized();
+    const Eigen::Vector2d q = xy + std::max(t, 0.0) * u;
+    const auto part = stretch_offset_.find(
+        {a, b, Floor(q.x(), options_.feather), Floor(q.y(), options_.feather)});
+    const double offset = part != stretch_offset_.end() ? part->second : whole->second;
+    if (std::isnan(offset)) continue;
+    // z_g - z_h: g moves down by half of it at the border.
+    const double g_minus_h = g == a ? offset : -offset;
+    dz -= 0.5 * g_minus_h * (1 - std::max(t, 0.0) / options_.feather);
+  }
+  return dz;
+}
+
+}  // namespace sapmvs
