@@ -63,7 +63,7 @@ class CliPlanTest : public ::testing::Test {
 fs::path* CliPlanTest::root_ = nullptr;
 
 TEST_F(CliPlanTest, PrintsTheGroupsOfTable3) {
-  const auto r = RunCli("plan " + Block());
+  const auto r = RunCli("plan " + Block() + " --strategy strip");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_NE(r.out.find("strips      4: 16 17 18 16 images"), std::string::npos) << r.out;
@@ -81,7 +81,8 @@ TEST_F(CliPlanTest, PrintsTheGroupsOfTable3) {
 
 TEST_F(CliPlanTest, JsonIsWrittenAndValid) {
   const fs::path json = *root_ / "plan.json";
-  const auto r = RunCli("plan " + Block() + " --json " + json.string() + " --max-images 5");
+  const auto r =
+      RunCli("plan " + Block() + " --strategy strip --json " + json.string() + " --max-images 5");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);

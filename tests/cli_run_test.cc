@@ -453,10 +453,11 @@ TEST_F(CliRunTest, ProfilePrintsKernelTablesAndWritesThem) {
 }
 
 // Whole-block runs: the tiny block (2 strips of 2 images) split into one
-// group per strip by --max-images 3, matched with min_image_num 2.
+// group per strip by --strategy strip --max-images 3, matched with
+// min_image_num 2.
 class CliBlockRunTest : public CliRunTest {
  protected:
-  static constexpr const char* kArgs = "--min-image-num 2 --max-images 3 -q";
+  static constexpr const char* kArgs = "--strategy strip --min-image-num 2 --max-images 3 -q";
   static std::string Args(const fs::path& out, const std::string& more = "") {
     return "run " + Block().string() + " --out " + out.string() + " " + kArgs + " " + more;
   }

@@ -11,13 +11,23 @@
 #include "plan/grouping_internal.h"
 #include "plan/strip_detection.h"
 #include "sapmvs/block/block_geometry.h"
+#include "sapmvs/block/block_reader.h"
 #include "sapmvs/match/match_group.h"
 #include "sapmvs/simulate/simulate.h"
 #include "sapmvs/util/error.h"
 #include "simulate/sim_presets.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
+
+// Strip grouping's options: the tests here are of it, and the default
+// strategy is footprint.
+GroupingOptions StripOptions() {
+  GroupingOptions o;
+  o.strategy = GroupingStrategy::kStrip;
+  return o;
+}
 
 // The cameras `sapmvs simulate --preset NAME` renders, as a block without
 // images (grouping never reads pixels). The simulator's mean ground is local
@@ -86,7 +96,7 @@ std::vector<std::vector<int>> TrueStrips(const SimBlock& s) {
 TEST(GroupingTable3, CampusStripStrategyMatchesThePaper) {
   const SimBlock s = MakeSimBlock("campus");
   ASSERT_EQ(s.block.images.size(), 67u);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   EXPECT_EQ(plan.strategy, GroupingStrategy::kStrip);
   EXPECT_EQ(plan.strips, TrueStrips(s));
   EXPECT_EQ(Sizes(plan), (std::vector<size_t>{6, 6, 4, 6, 6, 5, 6, 6, 6, 6, 6, 4}));
@@ -113,7 +123,7 @@ TEST(GroupingTable3, CampusStripStrategyMatchesThePaper) {
 // stay Table 3's.
 TEST(GroupingStrips, StripViewsComeFromTheNeighbouringStrips) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   ASSERT_EQ(o.strip_views, 2);
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   EXPECT_EQ(Sizes(plan), (std::vector<size_t>{6, 6, 4, 6, 6, 5, 6, 6, 6, 6, 6, 4}));
@@ -162,7 +172,7 @@ TEST(GroupingStrips, StripViewsComeFromTheNeighbouringStrips) {
 // fills up to 6.
 TEST(GroupingStrips, StripViewsStayWithinTheBudget) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3, 4, 5}, 1).Total() + 1;
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   for (const ImageGroup& g : plan.groups) {
@@ -182,7 +192,7 @@ TEST(GroupingSingle, ABlockThatFitsIsOneGroupAndALargerOneIsSplit) {
   const SimBlock s = MakeSimBlock("tiny");
   ASSERT_EQ(s.block.images.size(), 4u);
   for (const GroupingStrategy strategy : {GroupingStrategy::kStrip, GroupingStrategy::kFootprint}) {
-    GroupingOptions o;
+    GroupingOptions o = StripOptions();
     o.strategy = strategy;
     const GroupingPlan one = PlanGroups(s.block, o, MatcherOptions{});
     EXPECT_TRUE(one.single_group);
@@ -206,7 +216,7 @@ TEST(GroupingSingle, ABlockThatFitsIsOneGroupAndALargerOneIsSplit) {
 
 TEST(GroupingTable3, GroupCentresLieOnTheirImagesFootprints) {
   const SimBlock s = MakeSimBlock("campus");
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   for (const ImageGroup& g : plan.groups) {
     // Nadir images: the footprint centre is near the camera's XY.
     Eigen::Vector2d cams = Eigen::Vector2d::Zero();
@@ -231,13 +241,13 @@ TEST(GroupingStrips, ShuffledOrderGivesTheSameStripsInFlightOrder) {
   const auto expected = StripNames(s.block, TrueStrips(s));
   std::mt19937 rng(7);
   std::shuffle(s.block.images.begin(), s.block.images.end(), rng);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   EXPECT_EQ(StripNames(s.block, plan.strips), expected);
   // Same cut as in flight order: 6+6+4, 6+6+5, 6+6+6, 6+6+4 and the cross strip's.
   std::vector<size_t> sizes = Sizes(plan);
   std::sort(sizes.begin(), sizes.end());
   SimBlock ordered = MakeSimBlock("campus", true);
-  std::vector<size_t> want = Sizes(PlanGroups(ordered.block, GroupingOptions{}, MatcherOptions{}));
+  std::vector<size_t> want = Sizes(PlanGroups(ordered.block, StripOptions(), MatcherOptions{}));
   std::sort(want.begin(), want.end());
   EXPECT_EQ(sizes, want);
 }
@@ -245,7 +255,7 @@ TEST(GroupingStrips, ShuffledOrderGivesTheSameStripsInFlightOrder) {
 TEST(GroupingStrips, SingleStrip) {
   const SimBlock s = MakeSimBlock("campus", false, {2});
   ASSERT_EQ(s.block.images.size(), 18u);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   ASSERT_EQ(plan.strips.size(), 1u);
   std::vector<int> all(18);
   std::iota(all.begin(), all.end(), 0);
@@ -256,7 +266,7 @@ TEST(GroupingStrips, SingleStrip) {
 TEST(GroupingStrips, StripFlownBackwardsKeepsFlightOrder) {
   // Strip 1 flies -X: its images in flight order have decreasing X.
   const SimBlock s = MakeSimBlock("campus", false, {1});
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   ASSERT_EQ(plan.strips.size(), 1u);
   const auto& strip = plan.strips[0];
   for (size_t k = 1; k < strip.size(); ++k) {
@@ -268,7 +278,7 @@ TEST(GroupingStrips, StripFlownBackwardsKeepsFlightOrder) {
   SimBlock shuffled = s;
   std::mt19937 rng(3);
   std::shuffle(shuffled.block.images.begin(), shuffled.block.images.end(), rng);
-  const auto strips = PlanGroups(shuffled.block, GroupingOptions{}, MatcherOptions{}).strips;
+  const auto strips = PlanGroups(shuffled.block, StripOptions(), MatcherOptions{}).strips;
   EXPECT_EQ(StripNames(shuffled.block, strips), StripNames(s.block, plan.strips));
 }
 
@@ -277,7 +287,7 @@ TEST(GroupingStrips, ShortRemainderMovesTheCutsBack) {
   // 6 + 5 + 2 a group under the paper's smallest (4).
   SimBlock s = MakeSimBlock("campus", false, {0});
   s.block.images.resize(13);
-  const GroupingPlan plan13 = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan13 = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   EXPECT_EQ(Sizes(plan13), (std::vector<size_t>{5, 4, 4}));
   std::vector<int> all;
   for (const ImageGroup& g : plan13.groups) {
@@ -287,14 +297,14 @@ TEST(GroupingStrips, ShortRemainderMovesTheCutsBack) {
   EXPECT_EQ(all, plan13.strips[0]);  // each image once, in flight order
   MatcherOptions pairs;
   pairs.min_image_num = 2;
-  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{}, pairs)), (std::vector<size_t>{5, 4, 4}));
+  EXPECT_EQ(Sizes(PlanGroups(s.block, StripOptions(), pairs)), (std::vector<size_t>{5, 4, 4}));
   // 14 -> 6 + 4 + 4: the full runs first, as the paper's.
   s = MakeSimBlock("campus", false, {0});
   s.block.images.resize(14);
-  EXPECT_EQ(Sizes(PlanGroups(s.block, GroupingOptions{}, MatcherOptions{})),
+  EXPECT_EQ(Sizes(PlanGroups(s.block, StripOptions(), MatcherOptions{})),
             (std::vector<size_t>{6, 4, 4}));
   // Groups of 2 cannot have 4: a single image left shares the one before.
-  GroupingOptions two;
+  GroupingOptions two = StripOptions();
   two.max_images = 2;
   s.block.images.resize(5);
   const GroupingPlan plan = PlanGroups(s.block, two, MatcherOptions{});
@@ -312,7 +322,7 @@ TEST(GroupingStrips, LoneImageJoinsTheNearestGroup) {
   stray.camera = Camera::FromAngles(c.intrinsics(), c.center(), 0, 0, 90,
                                     AngleOrder::kOmegaPhiKappa, AngleUnit::kDegree);
   s.block.images.push_back(stray);
-  const GroupingPlan plan = PlanGroups(s.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
   // Off the strip's line after its end: a stray, not a strip of its own.
   EXPECT_EQ(plan.strips.size(), 1u);
   ASSERT_EQ(plan.outliers.size(), 1u);
@@ -363,7 +373,7 @@ int NearestGroup(const GroupingPlan& plan, const Eigen::Vector2d& xy) {
 
 TEST(GroupingFootprint, EveryGroundPointSeenTwiceIsOwnedByAGroupThatSeesIt) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.strategy = GroupingStrategy::kFootprint;
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   ASSERT_FALSE(plan.groups.empty());
@@ -387,12 +397,32 @@ TEST(GroupingFootprint, EveryGroundPointSeenTwiceIsOwnedByAGroupThatSeesIt) {
   EXPECT_EQ(owner_sees, matchable) << owner_sees << " of " << matchable;
 }
 
+// Footprint tiles need ground under the images: a facade block (the
+// default strategy) is grouped as the strip strategy groups it, every image
+// in a group.
+TEST(GroupingFootprint, ABlockThatDoesNotLookDownIsGroupedAsStrips) {
+  SAPMVS_REQUIRE_PATH(test::HerzJesu());
+  const Block block = ReadBlock(test::HerzJesu());
+  const BlockGeometry geometry = EstimateBlockGeometry(block);
+  ASSERT_FALSE(geometry.aerial);
+  GroupingOptions o;
+  ASSERT_EQ(o.strategy, GroupingStrategy::kFootprint);
+  o.max_images = 4;
+  const GroupingPlan plan = PlanGroups(block, o, MatcherOptions{}, &geometry);
+  EXPECT_EQ(plan.strategy, GroupingStrategy::kStrip);
+  EXPECT_GE(plan.groups.size(), 2u);
+  std::set<int> grouped;
+  for (const ImageGroup& g : plan.groups) grouped.insert(g.images.begin(), g.images.end());
+  EXPECT_EQ(grouped.size(), block.images.size());
+  EXPECT_TRUE(plan.ungrouped.empty());
+}
+
 TEST(GroupingFootprint, NoTwoGroupsMatchTheSameImages) {
   // Tiles that pick the same images are one group: matching the same images
   // twice only makes the same cloud twice.
   for (const char* preset : {"small", "campus"}) {
     const SimBlock s = MakeSimBlock(preset);
-    GroupingOptions o;
+    GroupingOptions o = StripOptions();
     o.strategy = GroupingStrategy::kFootprint;
     o.tile_size = 0.5;  // small tiles: neighbours often choose alike
     const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
@@ -407,7 +437,7 @@ TEST(GroupingFootprint, NoTwoGroupsMatchTheSameImages) {
 
 TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.strategy = GroupingStrategy::kFootprint;
   o.max_images = 5;
   o.tile_views = 5;
@@ -431,7 +461,7 @@ TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
 
 TEST(GroupingFootprint, SideOverlapBringsImagesOfNeighbouringStrips) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.strategy = GroupingStrategy::kFootprint;
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   int mixed = 0;
@@ -479,7 +509,7 @@ TEST(GroupingMemory, GrowsFourTimesPerLevelTowardsFullResolution) {
 
 TEST(GroupingMemory, TinyBudgetIsAClearError) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.memory_budget = 1 << 20;
   try {
     PlanGroups(s.block, o, MatcherOptions{});
@@ -498,7 +528,7 @@ TEST(GroupingMemory, TinyBudgetIsAClearError) {
 
 TEST(GroupingMemory, BudgetShortensTheRunsOfAStrip) {
   const SimBlock s = MakeSimBlock("campus");
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + 1;
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   // 16 -> 4+4+4+4, 17 -> 4+4+4+3+2, 18 -> 4+4+4+4+2, 16 -> 4+4+4+4, each
@@ -512,7 +542,7 @@ TEST(GroupingMemory, BudgetBelowTheFewestImagesAGroupCanMatchIsAnError) {
   const SimBlock s = MakeSimBlock("campus");
   MatcherOptions m;
   m.min_image_num = 4;
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   // Three images fit, four do not: groups of three would match nothing.
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, m).Total() + 1;
   try {
@@ -534,7 +564,7 @@ TEST(GroupingMemory, TheProcessCountsInEveryGroupAndInTheBudget) {
   // With what its first group adds to it for good.
   const double counted = process + MatcherMemory().runtime_warmup_bytes;
   EXPECT_GT(counted, process);
-  GroupingOptions o;
+  GroupingOptions o = StripOptions();
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + counted + 1;
   const GroupingPlan with = PlanGroups(s.block, o, MatcherOptions{}, nullptr, process);
   EXPECT_EQ(with.process_bytes, counted);
@@ -589,7 +619,7 @@ TEST(GroupingOptions, DefaultsAreValidAndEveryBoundaryIsChecked) {
 TEST(GroupingPlan, TooFewImages) {
   SimBlock s = MakeSimBlock("tiny");
   s.block.images.resize(1);
-  EXPECT_THROW(PlanGroups(s.block, GroupingOptions{}, MatcherOptions{}), Error);
+  EXPECT_THROW(PlanGroups(s.block, StripOptions(), MatcherOptions{}), Error);
 }
 
 }  // namespace

@@ -20,6 +20,14 @@
 namespace sapmvs {
 namespace {
 
+// Strip grouping's options: the tests here are of it, and the default
+// strategy is footprint.
+GroupingOptions StripOptions() {
+  GroupingOptions o;
+  o.strategy = GroupingStrategy::kStrip;
+  return o;
+}
+
 // 1200 x 900 px at f = 1000 px: 62 x 48 deg, a small UAV's camera.
 Intrinsics HandCamera() { return Intrinsics::FromFocalAndPixel(5.0, 5.0, 1200, 900); }
 
@@ -154,7 +162,7 @@ TEST(HandFlownStrips, FlightOrderComesFromTheNamesNotTheBlockOrder) {
 TEST(HandFlownGroups, NoSmallGroupAndNoImageLeftOutByEitherStrategy) {
   for (const unsigned seed : {1u, 2u, 3u}) {
     const Flown f = HandFlown(seed);
-    const GroupingPlan plan = PlanGroups(f.block, GroupingOptions{}, MatcherOptions{});
+    const GroupingPlan plan = PlanGroups(f.block, StripOptions(), MatcherOptions{});
     ASSERT_FALSE(plan.single_group);
     for (const ImageGroup& g : plan.groups) {
       EXPECT_GE(g.images.size(), 4u) << "seed " << seed;
@@ -175,7 +183,7 @@ TEST(HandFlownGroups, NoSmallGroupAndNoImageLeftOutByEitherStrategy) {
 
 TEST(HandFlownGroups, PlanListsTheOutliersAndWhy) {
   const Flown f = HandFlown(1);
-  const GroupingPlan plan = PlanGroups(f.block, GroupingOptions{}, MatcherOptions{});
+  const GroupingPlan plan = PlanGroups(f.block, StripOptions(), MatcherOptions{});
   ASSERT_FALSE(plan.outliers.empty());
   std::ostringstream text;
   PrintPlan(f.block, plan, text);

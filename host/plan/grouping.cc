@@ -455,9 +455,15 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   plan.strips = std::move(strips.strips);
   plan.outliers = std::move(strips.outliers);
   const std::vector<Footprint> fp = Footprints(block, geometry);
+  // Footprint tiles need ground under the images: a block that does not
+  // look down (a facade, a convergent close-range block) is grouped along
+  // its flight, or in block order, as the strip strategy groups it.
+  if (plan.strategy == GroupingStrategy::kFootprint && !geometry.aerial) {
+    plan.strategy = GroupingStrategy::kStrip;
+  }
   // The strategy's plan first, even for a block that is then kept whole: its
-  // checks (tile cost, a block that does not look down) are the options'.
-  if (options.strategy == GroupingStrategy::kStrip)
+  // checks (tile cost) are the options'.
+  if (plan.strategy == GroupingStrategy::kStrip)
     PlanStrips(block, options, fp, &plan);
   else
     PlanFootprint(block, options, geometry, fp, &plan);
@@ -475,7 +481,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
     plan.single_group = true;
     return plan;
   }
-  if (options.strategy == GroupingStrategy::kStrip) AddStripViews(block, options, fp, &plan);
+  if (plan.strategy == GroupingStrategy::kStrip) AddStripViews(block, options, fp, &plan);
   AddAngleViews(block, fp, &plan);
   for (ImageGroup& g : plan.groups) {
     const std::vector<int> matched_in = g.MatchedIn();

@@ -114,6 +114,8 @@ struct StripOutlier {
 };
 
 struct GroupingPlan {
+  // The strategy used: options.strategy, but strip for a block that does
+  // not look down, which has no ground to tile.
   GroupingStrategy strategy = GroupingStrategy::kStrip;
   GroupingOptions options;  // what the plan was made with
   // The matcher it was made for: its level, cell size and wave size (the
