@@ -323,7 +323,7 @@ Spacings MeasureSpacings(const sim::FlightPlan& plan) {
 
 // Footprint of the preset's sensor on the mean ground, image x (along track)
 // and image y, from the camera's data sheet rather than the plan.
-Eigen::Vector2d Footprint(const std::string& preset) {
+Eigen::Vector2d SensorFootprint(const std::string& preset) {
   const sim::Preset p = sim::FindPreset(preset);
   const double scale = p.flight.flying_height / p.camera.focal_mm * 1e-3;
   return Eigen::Vector2d(p.camera.width, p.camera.height) * p.camera.pixel_um * scale;
@@ -331,7 +331,7 @@ Eigen::Vector2d Footprint(const std::string& preset) {
 
 TEST(Simulate, OverlapFlagSetsBaseAndStripSpacing) {
   for (const std::string preset : {"small", "campus", "mountain"}) {
-    const Eigen::Vector2d footprint = Footprint(preset);
+    const Eigen::Vector2d footprint = SensorFootprint(preset);
     for (const auto& [forward, side] : {std::pair{88.0, 30.0}, {60.0, 20.0}, {95.0, 0.0}}) {
       SimulateOptions o;
       o.preset = preset;

@@ -4,6 +4,7 @@
 // groups, group_views.cc adds the images they are matched in).
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "sapmvs/block/block.h"
@@ -37,6 +38,9 @@ struct Footprint {
 };
 
 std::vector<Footprint> Footprints(const Block& block, const BlockGeometry& geometry);
+
+// v with `precision` digits after the point, for the plan's reports.
+std::string Fixed(double v, int precision);
 
 // A group's estimate with the process around it (PlanGroups' process_bytes),
 // which is what memory_budget bounds.

@@ -9,17 +9,19 @@
 #include <string>
 #include <vector>
 
+#include "plan/grouping_internal.h"
 #include "sapmvs/plan/grouping.h"
 #include "sapmvs/util/byte_size.h"
 
 namespace sapmvs {
-namespace {
 
 std::string Fixed(double v, int precision) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%.*f", precision, v);
   return buf;
 }
+
+namespace {
 
 // "IMG_1~IMG_6" for a run of consecutive block images (either way), else
 // every name.

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <numeric>
 
+#include "plan/grouping_internal.h"
 #include "sapmvs/block/block_geometry.h"
 
 namespace sapmvs {
@@ -68,12 +69,6 @@ double Median(std::vector<double> v) {
 double AngleDeg(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const double c = a.normalized().dot(b.normalized());
   return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / M_PI;
-}
-
-std::string Fixed(double v, int precision) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", precision, v);
-  return buf;
 }
 
 // A run of the flight path: seq[first..last], and its mean step direction.
