@@ -8,7 +8,8 @@
 #   scripts/test.sh --opencl [ctest args...]     only the tests that need an
 #       OpenCL device (label `opencl`), in build/
 #   scripts/test.sh --sanitize [ctest args...]   AddressSanitizer + UBSan build
-#       in build-sanitize/ (gcc; -O1, the test files -O0, unity batches;
+#       in build-sanitize/ (gcc; -O1, -O0 for the test files and the
+#       stages the host tests only pass through, unity batches; host/ and
 #       tests/CMakeLists.txt) of the tests that need no OpenCL device
 #       (label `host`, see tests/CMakeLists.txt); any report fails its test.
 #
