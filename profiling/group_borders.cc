@@ -49,9 +49,7 @@ double DistanceToCoreBoundary(const std::vector<Eigen::Vector2d>& centers, doubl
   double best = std::numeric_limits<double>::infinity();
   for (size_t g = 0; g < centers.size(); ++g) {
     if (g == own) continue;
-    const double d = ((p - centers[g]).squaredNorm() - (p - centers[own]).squaredNorm()) /
-                     (2 * (centers[g] - centers[own]).norm());
-    best = std::min(best, d);
+    best = std::min(best, BeyondBisector(centers[own], centers[g], p));
   }
   return best;
 }

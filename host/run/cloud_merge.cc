@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
@@ -50,6 +51,13 @@ int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
     }
   }
   return best;
+}
+
+double BeyondBisector(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                      const Eigen::Vector2d& p) {
+  const double length = (b - a).norm();
+  if (!(length > 0)) return std::numeric_limits<double>::infinity();
+  return ((p - b).squaredNorm() - (p - a).squaredNorm()) / (2 * length);
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "sapmvs/run/cloud_merge.h"
 #include "sapmvs/util/error.h"
 
 namespace sapmvs {
@@ -40,13 +41,6 @@ SeamLeveling::SeamLeveling(std::vector<Eigen::Vector2d> centers, const SeamOptio
   if (const std::string p = options.Problem(); !p.empty()) throw Error("seams: expected " + p);
 }
 
-double SeamLeveling::Beyond(int g, int h, const Eigen::Vector2d& p) const {
-  const Eigen::Vector2d d = centers_[h] - centers_[g];
-  const double length = d.norm();
-  if (!(length > 0)) return std::numeric_limits<double>::infinity();
-  return ((p - centers_[h]).squaredNorm() - (p - centers_[g]).squaredNorm()) / (2 * length);
-}
-
 std::pair<int, int> SeamLeveling::TwoNearest(const Eigen::Vector2d& p) const {
   int first = -1, second = -1;
   double d1 = 0, d2 = 0;
@@ -68,7 +62,7 @@ void SeamLeveling::Add(int g, const Eigen::Vector3d& p) {
   if (next < 0) return;
   // The border the point lies by: its owner's with the next nearest centre.
   if (g != owner && g != next) return;
-  if (std::abs(Beyond(owner, next, xy)) > options_.band) return;
+  if (std::abs(BeyondBisector(centers_[owner], centers_[next], xy)) > options_.band) return;
   const int a = std::min(owner, next), b = std::max(owner, next);
   heights_[{a, b, Floor(xy.x(), options_.cell), Floor(xy.y(), options_.cell), g == a ? 0 : 1}]
       .push_back(static_cast<float>(p.z()));
@@ -113,7 +107,7 @@ double SeamLeveling::Correction(int g, const Eigen::Vector3d& p) const {
   double dz = 0;
   for (int h = 0; h < static_cast<int>(centers_.size()); ++h) {
     if (h == g) continue;
-    const double t = Beyond(g, h, xy);
+    const double t = BeyondBisector(centers_[g], centers_[h], xy);
     if (!(t < options_.feather)) continue;
     const int a = std::min(g, h), b = std::max(g, h);
     const auto whole = pair_offset_.find({a, b});

@@ -88,6 +88,10 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
 // The index of the centre nearest to (x, y): the core owner; -1 for none.
 int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);
 
+// Signed distance from p to the bisector of centres a and b, the border of
+// their cores: positive on a's side; infinite when a and b coincide.
+double BeyondBisector(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p);
+
 // Pairs of points of different groups (group_of[i] is point i's group) within
 // `radius` of each other (3D): what the merge leaves none of. radius > 0.
 long CountCrossGroupPairs(const PointCloud& cloud, const std::vector<int>& group_of, double radius);

@@ -56,8 +56,6 @@ class SeamLeveling {
   double median_offset() const { return median_offset_; }
 
  private:
-  // Signed distance from p to the bisector of g and h, positive on g's side.
-  double Beyond(int g, int h, const Eigen::Vector2d& p) const;
   // The nearest and the next nearest centre to p.
   std::pair<int, int> TwoNearest(const Eigen::Vector2d& p) const;
 
