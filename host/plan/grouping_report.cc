@@ -59,9 +59,9 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
   out << " images";
   if (!plan.outliers.empty()) out << ", " << plan.outliers.size() << " outliers";
   out << "\n";
-  for (const StripOutlier& o : plan.outliers) {
-    const std::string joined = JoinedAs(plan, o.image);
-    out << "outlier     " << block.images[o.image].name << " " << o.reason << "; "
+  for (const StripOutlier& outlier : plan.outliers) {
+    const std::string joined = JoinedAs(plan, outlier.image);
+    out << "outlier     " << block.images[outlier.image].name << " " << outlier.reason << "; "
         << (joined.empty() ? "in no group" : "joins " + joined) << "\n";
   }
   out << "strategy    " << ToString(plan.strategy) << ": at most " << o.max_images
