@@ -63,7 +63,7 @@ class CliPlanTest : public ::testing::Test {
 fs::path* CliPlanTest::root_ = nullptr;
 
 TEST_F(CliPlanTest, PrintsTheGroupsOfTable3) {
-  const auto r = RunCli("plan " + Block() + " --strategy strip");
+  const auto r = RunCli("plan " + Block() + " --strategy strip --max-images 6");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_NE(r.out.find("strips      4: 16 17 18 16 images"), std::string::npos) << r.out;

@@ -262,6 +262,7 @@ TEST_F(CliRunTest, MemoryEstimateHoldsAndABudgetSplitsTheBlock) {
   const fs::path two_json = *root_ / "budget_two.json";
   const auto plan_two = RunCli("plan " + Block().string() +
                                " --level 0 --max-images 2 --min-image-num 2 --strip-views 0 "
+                               "--tile-extra-views 0 "
                                "--json " +
                                two_json.string());
   ASSERT_EQ(plan_two.exit_code, 0) << plan_two.err;

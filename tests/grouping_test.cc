@@ -26,6 +26,7 @@ namespace {
 GroupingOptions StripOptions() {
   GroupingOptions o;
   o.strategy = GroupingStrategy::kStrip;
+  o.max_images = 6;  // the paper's groups
   return o;
 }
 
@@ -457,6 +458,33 @@ TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
   o.memory_budget = 8.0 * (1ull << 30);
   for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups)
     EXPECT_LE(g.images.size(), 5u);
+}
+
+TEST(GroupingFootprint, ExtraViewsSeeTheTileAndAreNoneOfItsImages) {
+  const SimBlock s = MakeSimBlock("campus");
+  GroupingOptions o = StripOptions();
+  o.strategy = GroupingStrategy::kFootprint;
+  o.tile_extra_views = 0;
+  const GroupingPlan without = PlanGroups(s.block, o, MatcherOptions{});
+  o.tile_extra_views = 3;
+  const GroupingPlan with = PlanGroups(s.block, o, MatcherOptions{});
+  ASSERT_EQ(with.groups.size(), without.groups.size());
+  const std::vector<Footprint> fp = Footprints(s.block, EstimateBlockGeometry(s.block));
+  long added = 0;
+  for (size_t g = 0; g < with.groups.size(); ++g) {
+    const ImageGroup& a = with.groups[g];
+    added += static_cast<long>(a.views.size()) - static_cast<long>(without.groups[g].views.size());
+    for (const int v : a.views) {
+      EXPECT_EQ(std::count(a.images.begin(), a.images.end(), v), 0) << "group " << g + 1;
+      const Eigen::Vector2d c = (a.tile_min + a.tile_max) / 2;
+      const Eigen::Vector2d h = (a.tile_max - a.tile_min) / 2;
+      bool sees = false;
+      for (int k = 0; k < 9; ++k)
+        sees |= fp[v].Contains(c + Eigen::Vector2d((k % 3 - 1) * h.x(), (k / 3 - 1) * h.y()));
+      EXPECT_TRUE(sees) << "group " << g + 1 << ": view " << v << " sees none of the tile";
+    }
+  }
+  EXPECT_GE(added, static_cast<long>(with.groups.size()));
 }
 
 TEST(GroupingFootprint, SideOverlapBringsImagesOfNeighbouringStrips) {

@@ -303,37 +303,42 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
       // matchable only if the group holds both: at the paper's 92 % forward
       // overlap the central images alone fill the group otherwise), then
       // brings most samples closer to tile_views views; ties go to the
-      // image that sees more of the tile, then to the more nadir one.
+      // image that sees more of the tile, then to the more nadir one. The
+      // view-only images follow by the same rule.
       ImageGroup g;
       const int target = std::min(o.tile_views, o.max_images);
       const std::vector<int> available = views;
       std::fill(views.begin(), views.end(), 0);
       std::vector<bool> taken(candidates.size(), false);
-      while (static_cast<int>(g.images.size()) < o.max_images) {
-        int best = -1;
-        std::tuple<int, int, size_t, double> best_key{0, 0, 0, 0};
-        for (size_t c = 0; c < candidates.size(); ++c) {
-          if (taken[c]) continue;
-          int gain = 0, second = 0;
-          for (const int s : candidates[c].seen) {
-            gain += views[s] < target;
-            second += views[s] < std::min(2, available[s]);
+      auto pick = [&](int want, int goal, std::vector<int>* into) {
+        while (static_cast<int>(into->size()) < want) {
+          int best = -1;
+          std::tuple<int, int, size_t, double> best_key{0, 0, 0, 0};
+          for (size_t c = 0; c < candidates.size(); ++c) {
+            if (taken[c]) continue;
+            int gain = 0, second = 0;
+            for (const int s : candidates[c].seen) {
+              gain += views[s] < goal;
+              second += views[s] < std::min(2, available[s]);
+            }
+            const std::tuple<int, int, size_t, double> key{second, gain, candidates[c].seen.size(),
+                                                           candidates[c].nadir};
+            if (gain > 0 && (best < 0 || key > best_key)) {
+              std::vector<int> with = g.MatchedIn();
+              with.push_back(candidates[c].image);
+              if (!Fits(block, with, *plan)) continue;
+              best = static_cast<int>(c);
+              best_key = key;
+            }
           }
-          const std::tuple<int, int, size_t, double> key{second, gain, candidates[c].seen.size(),
-                                                         candidates[c].nadir};
-          if (gain > 0 && (best < 0 || key > best_key)) {
-            std::vector<int> with = g.images;
-            with.push_back(candidates[c].image);
-            if (!Fits(block, with, *plan)) continue;
-            best = static_cast<int>(c);
-            best_key = key;
-          }
+          if (best < 0) return;
+          taken[best] = true;
+          into->push_back(candidates[best].image);
+          for (const int s : candidates[best].seen) ++views[s];
         }
-        if (best < 0) break;
-        taken[best] = true;
-        g.images.push_back(candidates[best].image);
-        for (const int s : candidates[best].seen) ++views[s];
-      }
+      };
+      pick(o.max_images, target, &g.images);
+      pick(o.tile_extra_views, target + o.tile_extra_views, &g.views);
       if (g.images.size() < 2) continue;
       for (const int i : g.images) used[i] = true;
       // Neighbouring tiles often pick the same images; matching them twice

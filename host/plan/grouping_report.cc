@@ -68,7 +68,8 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
       << " images per group, level " << plan.matcher.level << ", memory budget "
       << FormatBytes(o.memory_budget);
   if (plan.strategy == GroupingStrategy::kFootprint)
-    out << ", tiles of " << Fixed(o.tile_size, 2) << " footprint, " << o.tile_views << " views";
+    out << ", tiles of " << Fixed(o.tile_size, 2) << " footprint, " << o.tile_views
+        << " views, up to " << o.tile_extra_views << " view-only images";
   else
     out << ", up to " << o.strip_views << " view-only images of other strips";
   out << "\n";
@@ -137,13 +138,10 @@ nlohmann::json PlanToJson(const Block& block, const GroupingPlan& plan) {
   j["origin"] = {block.origin.x(), block.origin.y(), block.origin.z()};
   j["strategy"] = ToString(plan.strategy);
   j["single_group"] = plan.single_group;
-  j["options"] = {{"max_images", o.max_images},
-                  {"memory_budget", o.memory_budget},
-                  {"level", plan.matcher.level},
-                  {"tile_size", o.tile_size},
-                  {"tile_views", o.tile_views},
-                  {"strip_views", o.strip_views},
-                  {"min_image_num", plan.matcher.min_image_num}};
+  j["options"] = {{"max_images", o.max_images},   {"memory_budget", o.memory_budget},
+                  {"level", plan.matcher.level},  {"tile_size", o.tile_size},
+                  {"tile_views", o.tile_views},   {"tile_extra_views", o.tile_extra_views},
+                  {"strip_views", o.strip_views}, {"min_image_num", plan.matcher.min_image_num}};
   j["strips"] = json::array();
   for (const auto& s : plan.strips) j["strips"].push_back({{"indices", s}, {"names", names(s)}});
   j["outliers"] = json::array();
