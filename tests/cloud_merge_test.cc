@@ -153,6 +153,35 @@ TEST(CloudMerge, AnotherGroupsLayerJustOffTheOwnersSurfaceIsNotStacked) {
   EXPECT_EQ(st.kept_by_group[1], static_cast<long>(b.points.size()));
 }
 
+TEST(CloudMerge, BothGroupsAreKeptWithinTheBlendBandOfTheirBorder) {
+  // Both groups matched all of [0, 20) x [0, 10), a little apart as with
+  // real orientations; their cores meet at x = 10.
+  const double s = 0.5;
+  const PointCloud a = Grid(0, 20, 0, 10, s, 0, 0, 100, 0.5f);
+  const PointCloud b = Grid(0, 20, 0, 10, s, s / 2, s / 2, 100 + 0.8 * s, 0.9f);
+  std::vector<GroupCloud> groups = {{&a, {500005.0, 5400005.0}}, {&b, {500015.0, 5400005.0}}};
+  MergeOptions o;
+  o.radius = s;
+  o.blend_radii = 3;
+  const double band = o.blend_radii * o.radius;
+  const std::vector<MergedRef> kept = MergeGroupRefs(groups, o);
+  long in_band = 0, kept_in_band = 0;
+  for (const auto* c : {&a, &b}) {
+    for (const CloudPoint& p : c->points) in_band += std::abs(p.position.x() - 500010.0) < band;
+  }
+  for (const MergedRef& r : kept) {
+    const double x = groups[r.group].cloud->points[r.index].position.x();
+    kept_in_band += std::abs(x - 500010.0) < band;
+    // Beyond the band only the owner's points stay.
+    if (std::abs(x - 500010.0) >= band) EXPECT_TRUE(r.core) << r.group << " at " << x;
+  }
+  EXPECT_EQ(kept_in_band, in_band);
+  EXPECT_GT(in_band, 0);
+  // Without the band, the owner's points alone, up to the border.
+  o.blend_radii = 0;
+  for (const MergedRef& r : MergeGroupRefs(groups, o)) EXPECT_TRUE(r.core);
+}
+
 TEST(CloudMerge, SurfacesAtOtherHeightsAreNotDuplicates) {
   // A roof 5 m above the ground seen by another group is another surface.
   const PointCloud a = Grid(0, 5, 0, 5, 0.5, 0, 0, 100, 0.9f);
@@ -273,6 +302,11 @@ TEST(CloudMerge, BadRadiusIsAnError) {
     EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
   }
   o.outside_core_radii = 1;
+  for (const double k : {-0.5, std::nan("")}) {
+    o.blend_radii = k;
+    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
+  }
+  o.blend_radii = 0;
   EXPECT_NO_THROW(MergeGroupClouds(groups, o));
 }
 

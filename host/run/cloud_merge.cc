@@ -30,6 +30,11 @@ std::string MergeOptions::Problem() const {
       << ", seam_band_radii = " << seam_band_radii << ")";
     return s.str();
   }
+  if (!(std::isfinite(blend_radii) && blend_radii >= 0)) {
+    std::ostringstream s;
+    s << "a blend band >= 0 radii (blend_radii = " << blend_radii << ")";
+    return s.str();
+  }
   if (tile_points < 1000)
     return "merge tile points >= 1000 (tile_points = " + std::to_string(tile_points) + ")";
   if (!(std::isfinite(halo_radii) && halo_radii >= 1)) {
@@ -58,6 +63,19 @@ double BeyondBisector(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
   const double length = (b - a).norm();
   if (!(length > 0)) return std::numeric_limits<double>::infinity();
   return ((p - b).squaredNorm() - (p - a).squaredNorm()) / (2 * length);
+}
+
+std::pair<int, double> CoreOwnerAndBorder(const std::vector<Eigen::Vector2d>& centers, double x,
+                                          double y) {
+  const int own = CoreOwner(centers, x, y);
+  double border = std::numeric_limits<double>::infinity();
+  if (own < 0) return {own, border};
+  const Eigen::Vector2d p(x, y);
+  for (size_t g = 0; g < centers.size(); ++g) {
+    if (static_cast<int>(g) != own)
+      border = std::min(border, BeyondBisector(centers[own], centers[g], p));
+  }
+  return {own, border};
 }
 
 namespace {
@@ -226,9 +244,11 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     Ref ref;
     bool core;
     bool contested;  // MayHaveForeignNeighbour
+    bool blend;      // within options.blend_radii of its core's border
     float score;
   };
   const double wide = options.radius * options.outside_core_radii;
+  const double blend_width = options.radius * options.blend_radii;
   const std::vector<uint8_t> contested = MayHaveForeignNeighbour(groups, wide);
   std::vector<Item> items(contested.size());
   size_t flat = 0;
@@ -238,9 +258,14 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     // The core owner compares each point with every group's centre.
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < pts.size(); ++i) {
-      const bool core =
-          CoreOwner(centers, pts[i].position.x(), pts[i].position.y()) == static_cast<int>(g);
-      items[flat + i] = {{static_cast<int>(g), i}, core, contested[flat + i] != 0, pts[i].score};
+      const auto [owner, border] =
+          CoreOwnerAndBorder(centers, pts[i].position.x(), pts[i].position.y());
+      const bool core = owner == static_cast<int>(g);
+      items[flat + i] = {{static_cast<int>(g), i},
+                         core,
+                         contested[flat + i] != 0,
+                         border < blend_width,
+                         pts[i].score};
     }
     flat += pts.size();
   }
@@ -261,9 +286,10 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
       const Eigen::Vector3d& p = point(item.ref).position;
       const double r = item.core ? options.radius : wide;
       const double r2 = r * r;
-      const bool duplicate = (item.core ? kept : kept_wide).AnyNear(p, [&](const Ref& other) {
-        return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
-      });
+      const bool duplicate =
+          !item.blend && (item.core ? kept : kept_wide).AnyNear(p, [&](const Ref& other) {
+            return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
+          });
       if (duplicate) {
         ++st.duplicates;
         continue;

@@ -272,6 +272,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   // In radii: the heights are compared where both groups matched, within
   // their margin of the border.
   job.merge.seam_feather_radii = options.seam_feather_gsd / options.merge_radius_gsd;
+  job.merge.blend_radii = options.seam_blend_gsd / options.merge_radius_gsd;
   job.merge.seam_band_radii = std::max(options.own_margin_gsd, 1.0) / options.merge_radius_gsd;
   job.merge.tile_points = options.merge_tile_points;
   job.dsm = options.dsm;

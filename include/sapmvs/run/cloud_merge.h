@@ -5,7 +5,8 @@
 //
 // Each group owns a core: the XY points nearer to its ground centre than to
 // any other group's (a Voronoi cell). Points are taken core points first,
-// then by score, best first; a core point is dropped when a point already
+// then by score, best first; a point within blend_radii of its core's
+// border is always kept; a core point is dropped when a point already
 // kept from another group lies within `radius` of it (3D), a point outside
 // its group's core when one lies within outside_core_radii radii. Points of
 // one group are never dropped for each other, so a group's own density stays
@@ -14,6 +15,7 @@
 // the owner's surface is not doubled by another group's a little off it.
 
 #include <Eigen/Core>
+#include <utility>
 #include <vector>
 
 #include "sapmvs/io/ply_io.h"
@@ -35,6 +37,12 @@ struct MergeOptions {
   // points between the owner's survived and stacked a second layer on its
   // surface, which doubled the merged cloud's local noise.
   double outside_core_radii = 3;
+  // Points within this many radii of their core's border are never
+  // duplicates (>= 0): two groups a little apart there would otherwise meet
+  // in a step, each group's cells correlated through its own patches and the
+  // two independent; with both kept, the cells by the border hold both
+  // surfaces.
+  double blend_radii = 0;
   // The tiled merge (tiled_merge.h): about this many group points per tile;
   // a block with no more than these is merged in one piece (>= 1000).
   long tile_points = 250000;  // RunOptions::merge_tile_points gives it
@@ -91,6 +99,11 @@ int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);
 // Signed distance from p to the bisector of centres a and b, the border of
 // their cores: positive on a's side; infinite when a and b coincide.
 double BeyondBisector(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p);
+
+// The core owner of (x, y) and the distance from it to the owner's core
+// border (infinite with one centre); owner -1 for no centre.
+std::pair<int, double> CoreOwnerAndBorder(const std::vector<Eigen::Vector2d>& centers, double x,
+                                          double y);
 
 // Pairs of points of different groups (group_of[i] is point i's group) within
 // `radius` of each other (3D): what the merge leaves none of. radius > 0.
