@@ -24,12 +24,6 @@ jobs=$(nproc 2>/dev/null || echo 2)
 if [ "${CI:-}" = "true" ] && [ $# -eq 0 ]; then
   bash scripts/install-deps.sh
   export SAPMVS_DEPS_INSTALLED=1
-  # The stages share 2 cores and keep both busy, so a thread that spins is
-  # time the other stage loses: OpenMP's idle threads then sleep at once.
-  # Three sanitizer tests (Propagator, TiledMerge, EvaluateLidar) took 30 and
-  # 31 user CPU seconds so against 35 and 37 spinning, 18 device tests 40
-  # against 44.
-  export OMP_WAIT_POLICY=PASSIVE
   # The two stages run side by side, each line marked with its stage. One
   # after the other they took 14.9 min on 2 cores for about 1,320 CPU
   # seconds, 1.5 cores busy on average: each stage's configure, links and
@@ -90,8 +84,7 @@ if [ ! -f build/CMakeCache.txt ]; then
   # time; the code is the same without it. Unity batches: 226 compile
   # seconds for the stage libraries against 400 file by file; the developer's
   # scripts/build.sh still compiles each file on its own.
-  [ "${CI:-}" = "true" ] &&
-    flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -DNDEBUG" -DSAPMVS_UNITY_BUILD=ON -DSAPMVS_TESTS_O0=ON)
+  [ "${CI:-}" = "true" ] && flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -DNDEBUG" -DSAPMVS_UNITY_BUILD=ON)
   cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${flags[@]}"
 fi
 # Only what the tests run (scripts/build.sh builds the profiling tools too).
