@@ -26,7 +26,6 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "sapmvs/block/block_geometry.h"
@@ -40,19 +39,6 @@
 using namespace sapmvs;
 
 namespace {
-
-// Distance from (x, y) to the boundary of the Voronoi cell of its nearest
-// centre: the smallest distance to a bisector with another centre.
-double DistanceToCoreBoundary(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
-  const Eigen::Vector2d p(x, y);
-  const size_t own = static_cast<size_t>(CoreOwner(centers, x, y));
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t g = 0; g < centers.size(); ++g) {
-    if (g == own) continue;
-    best = std::min(best, BeyondBisector(centers[own], centers[g], p));
-  }
-  return best;
-}
 
 // The group centres a run's report.json lists.
 std::vector<Eigen::Vector2d> ReportCenters(const nlohmann::json& report) {
@@ -177,7 +163,7 @@ int main(int argc, char** argv) {
     std::cout << "zone        points    within  median|dz|  coverage  (cells seen)\n";
     for (const bool border : {true, false}) {
       so.region = [&](double x, double y) {
-        return centers.size() > 1 && (DistanceToCoreBoundary(centers, x, y) <= band) == border;
+        return centers.size() > 1 && (CoreOwnerAndBorder(centers, x, y).second <= band) == border;
       };
       if (centers.size() < 2 && border) continue;
       if (centers.size() < 2) so.region = nullptr;

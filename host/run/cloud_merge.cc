@@ -258,8 +258,10 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     // The core owner compares each point with every group's centre.
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < pts.size(); ++i) {
-      const auto [owner, border] =
-          CoreOwnerAndBorder(centers, pts[i].position.x(), pts[i].position.y());
+      // The distance to the border only where a blend band asks for it.
+      const double x = pts[i].position.x(), y = pts[i].position.y();
+      const auto [owner, border] = blend_width > 0 ? CoreOwnerAndBorder(centers, x, y)
+                                                   : std::pair{CoreOwner(centers, x, y), 0.0};
       const bool core = owner == static_cast<int>(g);
       items[flat + i] = {{static_cast<int>(g), i},
                          core,
