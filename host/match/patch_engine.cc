@@ -55,6 +55,14 @@ PatchRefinerOptions RefineOptionsOf(const MatcherOptions& options) {
   return ro;
 }
 
+PatchRefinerOptions ExpansionOptionsOf(const MatcherOptions& options) {
+  PatchRefinerOptions ro = RefineOptionsOf(options);
+  ro.depth_step = kExpansionRefineDepthStep;
+  ro.angle_step_deg = kExpansionRefineAngleStepDeg;
+  ro.max_halvings = kExpansionRefineHalvings;
+  return ro;
+}
+
 // By patch side: the polish of each larger adaptive size (sapmvs mode).
 std::map<int, PatchRefinerOptions> PolishOptionsOf(const MatcherOptions& options) {
   std::map<int, PatchRefinerOptions> polish;
@@ -115,6 +123,7 @@ PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
       options_(options),
       role_(role),
       refine_options_(RefineOptionsOf(options)),
+      expansion_options_(ExpansionOptionsOf(options)),
       polish_options_(PolishOptionsOf(options)) {
   kernels_.SetGroup(group_.ncc);
 }
@@ -412,7 +421,12 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::EvaluateBatch(
     refine_views.push_back(std::move(kept));
     refine_of.push_back(patch_of[k]);
   }
-  const std::vector<RefinedPatch> refined = RefineWith(refine_options_, to_refine, refine_views);
+  // Seeds and expansions come in separate batches (Propagator).
+  const bool expansion = std::all_of(candidates.begin(), candidates.end(),
+                                     [](const PatchCandidate& c) { return c.has_parent; }) &&
+                         !candidates.empty();
+  const std::vector<RefinedPatch> refined =
+      RefineWith(expansion ? expansion_options_ : refine_options_, to_refine, refine_views);
 
   // 3. Accept on the views that pass threshold after optimisation.
   std::vector<int> accepted_index;

@@ -46,6 +46,7 @@ struct PatchCandidate {
   bool has_parent = false;
   Eigen::Vector3d parent_center = Eigen::Vector3d::Zero();
   Eigen::Vector3d parent_normal = Eigen::Vector3d::UnitZ();
+  float parent_score = 0;  // the parent's mean NCC (AcceptedPatch::score)
 };
 
 struct AcceptedPatch {
@@ -108,7 +109,9 @@ class PatchEngine {
   // result does not depend on the others in the batch, so a large batch is
   // evaluated as two halves on two threads: while one half's host steps run,
   // the other half's kernels keep the device busy, and on an OpenCL device
-  // the two halves' kernels run together (ClContext::QueueLease).
+  // the two halves' kernels run together (ClContext::QueueLease). A batch
+  // whose candidates all have a parent starts its refinement at the
+  // expansion steps (kExpansionRefineDepthStep).
   std::vector<std::optional<AcceptedPatch>> Evaluate(const std::vector<PatchCandidate>& candidates);
 
   // NCC of patches (centre, normal, ref) against `view`, window_size grid:
@@ -160,6 +163,8 @@ class PatchEngine {
   const MatcherOptions& options_;
   const Role role_;
   PatchRefinerOptions refine_options_;
+  // For a batch of expansion candidates (kExpansionRefineDepthStep).
+  PatchRefinerOptions expansion_options_;
   std::map<int, PatchRefinerOptions> polish_options_;  // by patch side (sapmvs)
   std::map<std::string, KernelTime> kernel_times_;
   // The halves of Evaluate launch from two threads. launch_mutex_ is held

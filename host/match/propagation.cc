@@ -11,6 +11,7 @@
 #include <limits>
 #include <new>
 #include <numeric>
+#include <unordered_map>
 
 namespace sapmvs {
 namespace {
@@ -230,6 +231,7 @@ void Propagator::Offer(const AcceptedPatch& patch, const Eigen::Vector2d& q,
   cand.has_parent = true;
   cand.parent_center = patch.center;
   cand.parent_normal = patch.normal;
+  cand.parent_score = patch.score;
   front->push_back(cand);
 }
 
@@ -559,6 +561,44 @@ void Propagator::Prune(const std::vector<bool>& keep) {
   }
 }
 
+std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wave) const {
+  const int r = std::max(1, options_.window_size / 2);
+  // Kept centres by (image, block of r x r pixels): a clash lies in the
+  // candidate's block or one of the 8 around it.
+  std::unordered_map<uint64_t, std::vector<Eigen::Vector2f>> kept;
+  auto key = [](int image, int bx, int by) {
+    return static_cast<uint64_t>(image) << 42 ^ static_cast<uint64_t>(by + (1 << 20)) << 21 ^
+           static_cast<uint64_t>(bx + (1 << 20));
+  };
+  std::vector<PatchCandidate> now, later;
+  for (PatchCandidate& c : *wave) {
+    const Eigen::Vector2f uv = group_.images[c.ref].camera.Project(c.center).cast<float>();
+    const int bx = static_cast<int>(std::floor(uv.x() / r));
+    const int by = static_cast<int>(std::floor(uv.y() / r));
+    bool clash = false;
+    for (int dy = -1; dy <= 1 && !clash; ++dy) {
+      for (int dx = -1; dx <= 1 && !clash; ++dx) {
+        const auto found = kept.find(key(c.ref, bx + dx, by + dy));
+        if (found == kept.end()) continue;
+        for (const Eigen::Vector2f& o : found->second) {
+          if (std::abs(o.x() - uv.x()) < r && std::abs(o.y() - uv.y()) < r) {
+            clash = true;
+            break;
+          }
+        }
+      }
+    }
+    if (clash) {
+      later.push_back(std::move(c));
+    } else {
+      kept[key(c.ref, bx, by)].push_back(uv);
+      now.push_back(std::move(c));
+    }
+  }
+  wave->swap(now);
+  return later;
+}
+
 void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) {
   const int cs = options_.cell_size;
   while (!front_.empty() && (options_.max_waves == 0 || waves_ < options_.max_waves)) {
@@ -579,6 +619,13 @@ void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) 
                               }),
                wave.end());
     if (wave.empty()) continue;
+    std::stable_sort(wave.begin(), wave.end(),
+                     [](const PatchCandidate& a, const PatchCandidate& b) {
+                       return a.parent_score > b.parent_score;
+                     });
+    std::vector<PatchCandidate> later = Crowded(&wave);
+    front_.insert(front_.begin(), std::make_move_iterator(later.begin()),
+                  std::make_move_iterator(later.end()));
     ++waves_;
     candidates_ += static_cast<long>(wave.size());
     largest_wave_ = std::max(largest_wave_, static_cast<long>(wave.size()));

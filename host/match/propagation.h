@@ -58,7 +58,16 @@ class Propagator {
   // Edge barriers for the flood fill (sapmvs mode); one map per image.
   void SetEdges(std::vector<EdgeMap> edges) { edges_ = std::move(edges); }
   // Waves until the front is empty (or max_waves). `on_wave` (may be empty)
-  // is called after each wave with its number, its size and the points.
+  // is called after each wave with its number, its size and the points. A
+  // wave takes its candidates best parent first, and one whose centre lies
+  // within half a window of an earlier one's in the same image waits for the
+  // next wave (Crowded): evaluated together, both were refined and accepted,
+  // and the second found its cells taken by the first. If the first fails,
+  // the second is tried next. On `small` and `city` at level 1 this cut the
+  // candidates refined by a fifth and the wall by 8-9 %, with coverage of
+  // the truth 79.8 / 75.3 % against 80.2 / 75.8 % and the points within
+  // 1 GSD 91.7 / 89.6 % against 91.7 / 89.8 % (taking them oldest first
+  // instead of best parent first: 79.6 / 75.3 %).
   void RunWaves(const std::function<void(long, long, long)>& on_wave);
   // Drops the points where keep[i] is false and frees their cells in every
   // grid, then queues the expansion of every patch that still has points
@@ -148,6 +157,10 @@ class Propagator {
   bool InRegion(const Eigen::Vector3d& x) const {
     return region_.Unbounded() || region_.Contains((x + group_.origin).head<2>());
   }
+  // Moves out of `wave` (in order) the candidates whose centre lies within
+  // window_size / 2 pixels, on both axes, of an earlier kept one's in the
+  // same reference image, and returns them in order.
+  std::vector<PatchCandidate> Crowded(std::vector<PatchCandidate>* wave) const;
   // Accepts the evaluated candidates best score first; returns accepted indices.
   std::vector<int> AcceptBatch(std::vector<std::optional<AcceptedPatch>>& results);
 
