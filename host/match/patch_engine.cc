@@ -55,11 +55,12 @@ PatchRefinerOptions RefineOptionsOf(const MatcherOptions& options) {
   return ro;
 }
 
-PatchRefinerOptions ExpansionOptionsOf(const MatcherOptions& options) {
+PatchRefinerOptions ExpansionOptionsOf(const MatcherOptions& options, PatchEngine::Role role) {
   PatchRefinerOptions ro = RefineOptionsOf(options);
   ro.depth_step = kExpansionRefineDepthStep;
   ro.angle_step_deg = kExpansionRefineAngleStepDeg;
-  ro.max_halvings = kExpansionRefineHalvings;
+  ro.max_halvings =
+      role == PatchEngine::Role::kOneCellPass ? kOneCellRefineHalvings : kExpansionRefineHalvings;
   return ro;
 }
 
@@ -123,7 +124,7 @@ PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
       options_(options),
       role_(role),
       refine_options_(RefineOptionsOf(options)),
-      expansion_options_(ExpansionOptionsOf(options)),
+      expansion_options_(ExpansionOptionsOf(options, role)),
       polish_options_(PolishOptionsOf(options)) {
   kernels_.SetGroup(group_.ncc);
 }

@@ -98,6 +98,15 @@ inline constexpr double kDefaultRefineMaxAngleDeg = 80.0;
 inline constexpr double kExpansionRefineDepthStep = 0.5;
 inline constexpr double kExpansionRefineAngleStepDeg = 4.0;
 inline constexpr int kExpansionRefineHalvings = 3;
+// A pmvs pass's one-cell patch (PatchEngine::Role::kOneCellPass) emits its
+// centre alone, which the filter then holds to its neighbours' plane within
+// half a footprint or more: its search stops one halving earlier, at depth
+// steps of 1/8 footprint. That pass was two thirds of the propagation's time
+// on `small` (80,293 candidates for 33,054 points); with 3 halvings against
+// 2 its wave time went 1.19 -> 0.92 s, and on `small` and `city` the points
+// within 1 GSD of the truth stayed 91.7 / 89.5 %, coverage 79.8 -> 79.7 %
+// and 75.3 -> 75.2 %, local noise 1.12 -> 1.10 cm and 4.25 -> 4.15 cm.
+inline constexpr int kOneCellRefineHalvings = 2;
 
 // Polishing (sapmvs mode, patch_engine.h): a patch refined at the window
 // size is refined again, briefly, at each larger adaptive size. Its depth is
