@@ -48,6 +48,20 @@ std::optional<double> DuplicateShare(const std::filesystem::path& run) {
   return j["merge"].value("cross_group_duplicates", 0.0) / input;
 }
 
+// NCC evaluations of the run's kernels per point of its cloud (report.json's
+// stages); none from a binary that does not count them.
+std::optional<double> WorkPerPoint(const std::filesystem::path& run) {
+  std::ifstream f(run / "report.json");
+  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  if (j.is_discarded() || !j.contains("stages") || !(j.value("points", 0.0) > 0)) {
+    return std::nullopt;
+  }
+  double evaluations = 0;
+  for (const nlohmann::json& s : j["stages"]) evaluations += s.value("ncc_evaluations", 0.0);
+  if (!(evaluations > 0)) return std::nullopt;
+  return evaluations / j["points"].get<double>();
+}
+
 }  // namespace
 
 std::string SurfaceTable(const std::vector<SurfaceRow>& rows, double gsd_level) {
@@ -63,7 +77,8 @@ std::string SurfaceTable(const std::vector<SurfaceRow>& rows, double gsd_level) 
   t << "| tool / mode | points | ground covered (" << Fixed(kCellGsd, 0)
     << " GSD cells, share of the union) | local noise median | local noise p90 | median/GSD "
        "| groups' own noise median (lowest–highest) | merged / groups' median "
-       "| cross-group duplicates |\n|---|---|---|---|---|---|---|---|---|\n";
+       "| cross-group duplicates | NCC evaluations per point |\n"
+       "|---|---|---|---|---|---|---|---|---|---|\n";
   for (size_t i = 0; i < rows.size(); ++i) {
     const SurfaceRow& r = rows[i];
     const LocalNoise n = MeasureLocalNoise(*r.cloud, noise);
@@ -81,7 +96,9 @@ std::string SurfaceTable(const std::vector<SurfaceRow>& rows, double gsd_level) 
         << ") | " << (n.sampled ? Fixed(n.median / median, 2) + "×" : "–") << " | ";
     }
     const std::optional<double> dup = r.run.empty() ? std::nullopt : DuplicateShare(r.run);
-    t << (dup ? Fixed(100 * *dup, 1) + " %" : "–") << " |\n";
+    const std::optional<double> work = r.run.empty() ? std::nullopt : WorkPerPoint(r.run);
+    t << (dup ? Fixed(100 * *dup, 1) + " %" : "–") << " | " << (work ? Fixed(*work, 1) : "–")
+      << " |\n";
   }
   return t.str();
 }

@@ -4,7 +4,9 @@
 // 4 GSD, as a share of what all of them cover; its local noise; for a
 // sapmvs run of several groups, the noise of each group's own cloud before
 // the merge and the share of the matched points the merge dropped as
-// another group's duplicates.
+// another group's duplicates; for a sapmvs run, its kernels' NCC evaluations
+// (one window in one view pair) per point of its cloud: the work, which
+// device and clock do not change.
 #include <filesystem>
 #include <optional>
 #include <string>

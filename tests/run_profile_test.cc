@@ -31,7 +31,8 @@ RunReport MadeUpReport() {
   refine.max_seconds = 1.5;
   r.stats.kernels["ncc_score 7x7"] = score;
   r.stats.kernels["patch_refine 21x21"] = refine;
-  r.stats.stages = {{"load", {1.0, 0.0, 1.0}}, {"propagation", {3.0, 2.5, 5.4}}};
+  r.stats.stages = {{"load", {1.0, 0.0, 1.0}}, {"propagation", {3.0, 2.5, 5.4, 0, 5350}}};
+  r.points = 1000;
   r.stages = {{"plan", 0.5}, {"match", 4.0}, {"merge", 2.0}};
   return r;
 }
@@ -80,6 +81,21 @@ TEST(RunProfile, MatchingPhasesSayHowBusyTheyKeptTheCores) {
   // propagation 5.4 / 3.0 s; the matching, (1.0 + 5.4) / (1.0 + 3.0) s.
   EXPECT_NE(text.find("1.80"), std::string::npos) << text;
   EXPECT_NE(text.find("matching 4.000 s wall, CPU/wall 1.60"), std::string::npos) << text;
+}
+
+TEST(RunProfile, PhasesCountTheWorkPerPoint) {
+  std::ostringstream out;
+  PrintProfile(MadeUpReport(), out);
+  const std::string text = out.str();
+  // propagation's 5350 evaluations over the cloud's 1000 points.
+  EXPECT_NE(text.find("5.3"), std::string::npos) << text;
+  EXPECT_NE(text.find("work 5350 NCC evaluations, 5.3 per point of the cloud"), std::string::npos)
+      << text;
+  RunReport none = MadeUpReport();
+  none.points = 0;
+  std::ostringstream quiet;
+  PrintProfile(none, quiet);
+  EXPECT_EQ(quiet.str().find("\nwork "), std::string::npos) << quiet.str();
 }
 
 class RunProfileFiles : public test::ScratchTest {};

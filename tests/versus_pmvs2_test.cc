@@ -139,6 +139,16 @@ TEST_F(VersusPmvs2Test, RunsPmvs2TwiceAndComparesEachCloudWithTheFirst) {
   EXPECT_GT(std::stod(ours[8]), 0) << ours[8];
   EXPECT_LE(std::stod(ours[7]) + std::stod(ours[8]), std::stod(ours[6]) + 2);
 
+  // The second table's last column, the work per point: counted for sapmvs
+  // (its report.json), none for PMVS2.
+  const std::string surface = markdown.substr(markdown.find("| tool / mode | points |"));
+  const std::vector<std::string> our_work = Row(surface, "sapmvs --mode sapmvs");
+  const std::vector<std::string> pmvs2_work = Row(surface, "PMVS2");
+  ASSERT_FALSE(our_work.empty()) << surface;
+  ASSERT_FALSE(pmvs2_work.empty()) << surface;
+  EXPECT_GT(std::stod(our_work.back()), 1.0) << surface;
+  EXPECT_EQ(pmvs2_work.back(), "–") << surface;
+
   // Against the truth, the last column: sapmvs's points lie on the true
   // surface, the stand-in's 100 m apart on the local frame's plane mostly
   // not.

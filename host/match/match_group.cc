@@ -33,6 +33,14 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+double NccEvaluations(const std::vector<const PatchEngine*>& engines) {
+  double n = 0;
+  for (const PatchEngine* engine : engines) {
+    for (const auto& [name, t] : engine->kernel_times()) n += t.ncc_evaluations;
+  }
+  return n;
+}
+
 double DeviceSeconds(const std::vector<const PatchEngine*>& engines) {
   double s = 0;
   for (const PatchEngine* engine : engines) {
@@ -131,6 +139,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   report("load");
   auto stage_start = std::chrono::steady_clock::now();
   double device_before = 0;
+  double evaluations_before = 0;
   double cpu_before = ProcessCpuSeconds();
   std::vector<const PatchEngine*> engines;  // those launched so far
   auto end_stage = [&](const std::string& name) {
@@ -143,6 +152,9 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     cpu_before = cpu_now;
     t.peak_rss_bytes = PeakRssBytes();
     device_before = device_now;
+    const double evaluations_now = NccEvaluations(engines);
+    t.ncc_evaluations = evaluations_now - evaluations_before;
+    evaluations_before = evaluations_now;
     // Stages repeated by the expand-filter passes add up under one name.
     auto same = std::find_if(stats.stages.begin(), stats.stages.end(),
                              [&](const auto& s) { return s.first == name; });
@@ -152,6 +164,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
       same->second.wall += t.wall;
       same->second.device += t.device;
       same->second.cpu += t.cpu;
+      same->second.ncc_evaluations += t.ncc_evaluations;
       same->second.peak_rss_bytes = t.peak_rss_bytes;
     }
     stage_start = std::chrono::steady_clock::now();

@@ -88,6 +88,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
       it->second.wall += t.wall;
       it->second.device += t.device;
       it->second.cpu += t.cpu;
+      it->second.ncc_evaluations += t.ncc_evaluations;
       it->second.peak_rss_bytes = std::max(it->second.peak_rss_bytes, t.peak_rss_bytes);
     }
   }

@@ -44,7 +44,7 @@ std::vector<KernelProfile> ProfileKernels(const MatchStats& stats) {
 std::vector<PhaseProfile> ProfilePhases(const RunReport& report) {
   std::vector<PhaseProfile> out;
   for (const auto& [name, t] : report.stats.stages) {
-    out.push_back({name, t.wall, t.device, t.cpu});
+    out.push_back({name, t.wall, t.device, t.cpu, t.ncc_evaluations});
   }
   for (const auto& [name, wall] : report.stages) {
     if (name == "match") continue;  // the stages above, summed
@@ -84,23 +84,33 @@ void PrintProfile(const RunReport& report, std::ostream& out) {
     out << line;
   }
   if (device == 0) out << "(no device times: the queue did not profile)\n";
+  // The work per output point: NCC evaluations of one window in one view
+  // pair, per point of the cloud, which device speed and clock do not change.
+  const double points = static_cast<double>(report.points);
   out << "\nprofile: phases, by wall time (host = wall - device; CPU/wall of the matching"
-         " phases)\n";
-  std::snprintf(line, sizeof line, "%-18s %10s %10s %10s %7s %9s\n", "phase", "wall s", "device s",
-                "host s", "share", "CPU/wall");
+         " phases; NCC evaluations per point of the cloud)\n";
+  std::snprintf(line, sizeof line, "%-18s %10s %10s %10s %7s %9s %10s\n", "phase", "wall s",
+                "device s", "host s", "share", "CPU/wall", "NCC/point");
   out << line;
-  double match_wall = 0, match_cpu = 0;
+  double match_wall = 0, match_cpu = 0, evaluations = 0;
   for (const PhaseProfile& p : ProfilePhases(report)) {
     const std::string busy = p.cpu > 0 && p.wall > 0 ? F("%.2f", p.cpu / p.wall) : "-";
-    std::snprintf(line, sizeof line, "%-18s %10.3f %10.3f %10.3f %6.1f%% %9s\n", p.phase.c_str(),
-                  p.wall, p.device, p.host(),
+    const std::string work =
+        p.ncc_evaluations > 0 && points > 0 ? F("%.1f", p.ncc_evaluations / points) : "-";
+    std::snprintf(line, sizeof line, "%-18s %10.3f %10.3f %10.3f %6.1f%% %9s %10s\n",
+                  p.phase.c_str(), p.wall, p.device, p.host(),
                   report.total_seconds > 0 ? 100 * p.wall / report.total_seconds : 0.0,
-                  busy.c_str());
+                  busy.c_str(), work.c_str());
     out << line;
     if (p.cpu > 0) {
       match_wall += p.wall;
       match_cpu += p.cpu;
     }
+    evaluations += p.ncc_evaluations;
+  }
+  if (evaluations > 0 && points > 0) {
+    out << "work " << F("%.4g", evaluations) << " NCC evaluations, "
+        << F("%.1f", evaluations / points) << " per point of the cloud\n";
   }
   if (match_wall > 0) {
     out << "matching " << F("%.3f", match_wall) << " s wall, CPU/wall "
@@ -126,8 +136,8 @@ void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
         << k.gb_per_second << "," << k.gflop_per_second << ",,,,\n";
     }
     for (const PhaseProfile& p : phases) {
-      f << "phase," << p.phase << ",,,,,,,,,,,,," << p.wall << "," << p.device << "," << p.host()
-        << "," << p.cpu << "\n";
+      f << "phase," << p.phase << ",,," << p.ncc_evaluations << ",,,,,,,,,," << p.wall << ","
+        << p.device << "," << p.host() << "," << p.cpu << "\n";
     }
   });
   nlohmann::json j;
@@ -155,7 +165,8 @@ void WriteProfile(const RunReport& report, const std::filesystem::path& csv) {
                            {"wall_s", p.wall},
                            {"device_s", p.device},
                            {"host_s", p.host()},
-                           {"cpu_s", p.cpu}});
+                           {"cpu_s", p.cpu},
+                           {"ncc_evaluations", p.ncc_evaluations}});
   }
   std::filesystem::path json_path = csv;
   json_path.replace_extension(".json");

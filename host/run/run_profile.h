@@ -45,7 +45,8 @@ std::vector<KernelProfile> ProfileKernels(const MatchStats& stats);
 struct PhaseProfile {
   std::string phase;
   double wall = 0, device = 0;
-  double cpu = 0;  // process CPU seconds; 0 for the run's own phases (not measured)
+  double cpu = 0;              // process CPU seconds; 0 for the run's own phases (not measured)
+  double ncc_evaluations = 0;  // of the phase's kernels (StageTime::ncc_evaluations)
   double host() const { return wall - device; }
 };
 // Matching stages (summed over groups), then the run's own; sorted by wall time.

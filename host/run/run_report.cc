@@ -57,12 +57,16 @@ nlohmann::json MatchStatsJson(const MatchStats& s, bool device_times) {
     nlohmann::json stage = {{"stage", name}, {"wall_seconds", t.wall}};
     if (device_times) stage["device_seconds"] = t.device;
     stage["cpu_seconds"] = t.cpu;
+    if (t.ncc_evaluations > 0) stage["ncc_evaluations"] = t.ncc_evaluations;
     stages.push_back(stage);
   }
   j["stages"] = stages;
   nlohmann::json kernels = nlohmann::json::array();
   for (const auto& [name, t] : s.kernels) {
-    nlohmann::json kernel = {{"kernel", name}, {"launches", t.launches}, {"items", t.items}};
+    nlohmann::json kernel = {{"kernel", name},
+                             {"launches", t.launches},
+                             {"items", t.items},
+                             {"ncc_evaluations", t.ncc_evaluations}};
     if (device_times) kernel["device_seconds"] = t.seconds;
     kernels.push_back(kernel);
   }

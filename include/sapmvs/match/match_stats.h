@@ -21,6 +21,9 @@ struct StageTime {
   // peak at its start (ResetPeakRss), else the process's; over a run's
   // groups, the highest.
   double peak_rss_bytes = 0;
+  // NCC evaluations of the stage's kernels (KernelTime::ncc_evaluations):
+  // the work, comparable across devices and commits.
+  double ncc_evaluations = 0;
 };
 
 struct KernelTime {
