@@ -120,5 +120,47 @@ TEST(NearestWithin, RefusesMismatchedSizesAndBadRadii) {
   EXPECT_TRUE(NearestWithin({}, {}, 4).empty());
 }
 
+// NearestOther against the scan with an unbounded radius, on clouds whose
+// nearest neighbours lie from a fraction of the mean spacing to far beyond
+// it: isolated points, two clusters 10^5 apart, a wall, a line, one place.
+TEST(NearestOther, FindsTheScansNearestAtAnyDistance) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0, 1);
+  std::vector<std::vector<float>> clouds(6);
+  for (int i = 0; i < 700; ++i) {
+    const float x = u(rng) * 20, y = u(rng) * 20;
+    clouds[0].insert(clouds[0].end(), {x + 1000.f, y - 500.f, 0.3f * std::sin(x) + 80.f});
+    const float off = i % 2 ? 1e5f : 0.f;
+    clouds[1].insert(clouds[1].end(), {off + 3 * u(rng), off + 3 * u(rng), u(rng)});
+    clouds[2].insert(clouds[2].end(), {5.f + 0.01f * u(rng), 20 * u(rng), 10 * u(rng)});
+    clouds[3].insert(clouds[3].end(), {static_cast<float>(i) * 0.5f, 0.f, 0.f});
+    clouds[4].insert(clouds[4].end(), {1.f, 2.f, 3.f});
+  }
+  // A dense patch and a few points scattered far around it.
+  for (int i = 0; i < 500; ++i) clouds[5].insert(clouds[5].end(), {u(rng), u(rng), 0.f});
+  for (int i = 0; i < 9; ++i) {
+    clouds[5].insert(clouds[5].end(), {400 * u(rng) - 200, 400 * u(rng) - 200, 50 * u(rng)});
+  }
+  for (const std::vector<float>& xyz : clouds) {
+    const size_t n = xyz.size() / 3;
+    std::vector<size_t> queries;
+    for (size_t a = 0; a < n; a += 3) queries.push_back(a);
+    queries.push_back(n - 1);
+    const std::vector<int32_t> got = NearestOther(xyz, queries);
+    const std::vector<int32_t> want = ScanAll(xyz, std::vector<double>(n, 1e7), 1);
+    ASSERT_EQ(got.size(), queries.size());
+    long differ = 0;
+    for (size_t q = 0; q < queries.size(); ++q) differ += got[q] != want[queries[q]];
+    EXPECT_EQ(differ, 0) << "of " << queries.size() << " queries, " << n << " points";
+  }
+}
+
+TEST(NearestOther, OnePointHasNoneAndBadInputIsRefused) {
+  EXPECT_EQ(NearestOther({1, 2, 3}, {0}), (std::vector<int32_t>{-1}));
+  EXPECT_TRUE(NearestOther({}, {}).empty());
+  EXPECT_THROW(NearestOther({1, 2, 3, 4}, {0}), Error);
+  EXPECT_THROW(NearestOther({1, 2, 3, 4, 5, 6}, {2}), Error);
+}
+
 }  // namespace
 }  // namespace sapmvs

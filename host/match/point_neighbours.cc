@@ -4,9 +4,11 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <string>
+#include <utility>
 
 #include "sapmvs/util/error.h"
 
@@ -54,19 +56,27 @@ inline float KeyDistance(uint64_t key) {
   return d2;
 }
 
+// The lowest and highest coordinate of the points on each axis.
+std::pair<std::array<double, 3>, std::array<double, 3>> Bounds(const std::vector<float>& xyz) {
+  std::array<double, 3> lo, hi;
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  for (size_t a = 0; a < xyz.size() / 3; ++a) {
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], static_cast<double>(xyz[3 * a + c]));
+      hi[c] = std::max(hi[c], static_cast<double>(xyz[3 * a + c]));
+    }
+  }
+  return {lo, hi};
+}
+
 class ColumnGrid {
  public:
   ColumnGrid(const std::vector<float>& xyz, double cell_hint) {
     const size_t n = xyz.size() / 3;
-    std::array<double, 3> lo, hi;
-    lo.fill(std::numeric_limits<double>::infinity());
-    hi.fill(-std::numeric_limits<double>::infinity());
-    for (size_t a = 0; a < n; ++a) {
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], static_cast<double>(xyz[3 * a + c]));
-        hi[c] = std::max(hi[c], static_cast<double>(xyz[3 * a + c]));
-      }
-    }
+    const auto bounds = Bounds(xyz);
+    const std::array<double, 3>& lo = bounds.first;
+    const std::array<double, 3>& hi = bounds.second;
     // The column runs along the axis the cloud spans least: a terrain's
     // height, a facade's depth.
     std::array<int, 3> axes = {0, 1, 2};
@@ -251,6 +261,59 @@ UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
           radius[a] * (1 + 1e-5) + 1e-6 * (std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2]) + 1);
       grid.Nearest(q, static_cast<int32_t>(a), static_cast<float>(radius[a] * radius[a]), reach, k,
                    &out[a * k], &best);
+    }
+  }
+  return out;
+}
+
+std::vector<int32_t> NearestOther(const std::vector<float>& xyz,
+                                  const std::vector<size_t>& queries) {
+  if (xyz.size() % 3 != 0) {
+    throw Error("NearestOther: expected 3 coordinates per point (" + std::to_string(xyz.size()) +
+                " coordinates)");
+  }
+  const size_t n = xyz.size() / 3;
+  if (n > static_cast<size_t>(std::numeric_limits<int32_t>::max())) {
+    throw Error("NearestOther: " + std::to_string(n) +
+                " points, more than an int32 index holds (2^31 - 1)");
+  }
+  for (const size_t q : queries) {
+    if (q >= n) {
+      throw Error("NearestOther: query " + std::to_string(q) + " of " + std::to_string(n) +
+                  " points");
+    }
+  }
+  std::vector<int32_t> out(queries.size(), -1);
+  if (n < 2) return out;
+  // The cloud's extent over its two widest axes, and its diagonal: the
+  // reach past which no point can lie.
+  const auto bounds = Bounds(xyz);
+  const std::array<double, 3>& lo = bounds.first;
+  const std::array<double, 3>& hi = bounds.second;
+  std::array<double, 3> extent = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+  std::sort(extent.begin(), extent.end(), std::greater<double>());
+  const double diagonal =
+      std::sqrt(extent[0] * extent[0] + extent[1] * extent[1] + extent[2] * extent[2]);
+  // About four points per column where the points are spread evenly; a
+  // cloud on a line or at one point falls back to the grid's own floor.
+  const double spacing = std::sqrt(extent[0] * extent[1] / static_cast<double>(n));
+  const ColumnGrid grid(xyz, spacing > 0 ? 2 * spacing : diagonal / 1024);
+  const double first_reach = spacing > 0 ? 2 * spacing : std::max(diagonal, 1e-30);
+  const long m = static_cast<long>(queries.size());
+#pragma omp parallel
+  {
+    std::vector<uint64_t> best;
+#pragma omp for schedule(dynamic, 512)
+    for (long i = 0; i < m; ++i) {
+      const size_t a = queries[i];
+      const float* p = &xyz[3 * a];
+      const double pad = 1e-6 * (std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]) + 1);
+      for (double reach = first_reach;; reach *= 2) {
+        const float r2 = static_cast<float>(reach * reach);
+        grid.Nearest(p, static_cast<int32_t>(a), r2, reach * (1 + 1e-5) + pad, 1, &out[i], &best);
+        // Past the diagonal every other point was within reach.
+        if (out[i] >= 0 || reach > 2 * diagonal + pad) break;
+      }
     }
   }
   return out;

@@ -28,4 +28,14 @@ namespace sapmvs {
 UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
                                            const std::vector<double>& radius, int k);
 
+// For each of `queries` (indices of points of `xyz`, laid out as above): the
+// index of its nearest other point at any distance, by the float distance
+// NearestWithin sums (ties by index); -1 for a cloud of one point. The same
+// grid, sized to a few points per column at the cloud's mean density, is
+// searched within a reach that doubles until a point is found. Throws Error
+// when xyz's size is not a multiple of 3, a query is out of range, or there
+// are more than 2^31 - 1 points.
+std::vector<int32_t> NearestOther(const std::vector<float>& xyz,
+                                  const std::vector<size_t>& queries);
+
 }  // namespace sapmvs
