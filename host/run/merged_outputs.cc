@@ -1,6 +1,7 @@
 #include "run/merged_outputs.h"
 
 #include <algorithm>
+#include <future>
 
 #include "run/point_spill.h"
 #include "run/streamed_dsm.h"
@@ -90,8 +91,17 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
   report->density = fp.density;
   end_stage("statistics");
 
-  WritePlyStream(ply, format, ply_counts, spill.Read());
+  // The three writers read the spill each on its own and share nothing, so
+  // they run side by side: one after the other they were the run's last
+  // serial stage. The readers are opened here, as Read flushes the spill.
+  NextPoints ply_next = spill.Read();
   NextPoints las_next = spill.Read();
+  std::future<void> ply_done = std::async(
+      std::launch::async, [&] { WritePlyStream(ply, format, ply_counts, std::move(ply_next)); });
+  std::future<void> dsm_done = std::async(std::launch::async, [&] {
+    WriteGeoTiff(job.out / "dsm.tif", dsm);
+    WriteDsmPictures(dsm, job.out / "dsm_color.tif", job.out / "dsm.png");
+  });
   PointCloud chunk = format;
   std::vector<PointRecord> records;
   std::vector<LasExtraField> extras;
@@ -107,8 +117,8 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
         *fields = &extras;
         return true;
       });
-  WriteGeoTiff(job.out / "dsm.tif", dsm);
-  WriteDsmPictures(dsm, job.out / "dsm_color.tif", job.out / "dsm.png");
+  ply_done.get();
+  dsm_done.get();
   end_stage("write");
 }
 
