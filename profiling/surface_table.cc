@@ -38,21 +38,23 @@ std::vector<double> GroupNoise(const std::filesystem::path& run, const LocalNois
   return medians;
 }
 
-// The merge's cross-group duplicates as a share of its input (report.json).
-std::optional<double> DuplicateShare(const std::filesystem::path& run) {
+// A run's report.json; discarded (is_discarded()) when unreadable.
+nlohmann::json ReadReport(const std::filesystem::path& run) {
   std::ifstream f(run / "report.json");
-  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+  return nlohmann::json::parse(f, nullptr, false);
+}
+
+// The merge's cross-group duplicates as a share of its input.
+std::optional<double> DuplicateShare(const nlohmann::json& j) {
   if (j.is_discarded() || !j.contains("merge")) return std::nullopt;
   const double input = j["merge"].value("input", 0.0);
   if (!(input > 0)) return std::nullopt;
   return j["merge"].value("cross_group_duplicates", 0.0) / input;
 }
 
-// NCC evaluations of the run's kernels per point of its cloud (report.json's
+// NCC evaluations of the run's kernels per point of its cloud (the report's
 // stages); none from a binary that does not count them.
-std::optional<double> WorkPerPoint(const std::filesystem::path& run) {
-  std::ifstream f(run / "report.json");
-  const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
+std::optional<double> WorkPerPoint(const nlohmann::json& j) {
   if (j.is_discarded() || !j.contains("stages") || !(j.value("points", 0.0) > 0)) {
     return std::nullopt;
   }
@@ -95,8 +97,9 @@ std::string SurfaceTable(const std::vector<SurfaceRow>& rows, double gsd_level) 
       t << Fixed(median, 4) << " (" << Fixed(own.front(), 4) << "–" << Fixed(own.back(), 4)
         << ") | " << (n.sampled ? Fixed(n.median / median, 2) + "×" : "–") << " | ";
     }
-    const std::optional<double> dup = r.run.empty() ? std::nullopt : DuplicateShare(r.run);
-    const std::optional<double> work = r.run.empty() ? std::nullopt : WorkPerPoint(r.run);
+    const nlohmann::json report = r.run.empty() ? nlohmann::json() : ReadReport(r.run);
+    const std::optional<double> dup = r.run.empty() ? std::nullopt : DuplicateShare(report);
+    const std::optional<double> work = r.run.empty() ? std::nullopt : WorkPerPoint(report);
     t << (dup ? Fixed(100 * *dup, 1) + " %" : "–") << " | " << (work ? Fixed(*work, 1) : "–")
       << " |\n";
   }

@@ -33,20 +33,13 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-double NccEvaluations(const std::vector<const PatchEngine*>& engines) {
-  double n = 0;
+// Every kernel of the engines summed: device seconds and NCC evaluations.
+KernelTime KernelTotals(const std::vector<const PatchEngine*>& engines) {
+  KernelTime sum;
   for (const PatchEngine* engine : engines) {
-    for (const auto& [name, t] : engine->kernel_times()) n += t.ncc_evaluations;
+    for (const auto& [name, t] : engine->kernel_times()) AddKernelTime(t, &sum);
   }
-  return n;
-}
-
-double DeviceSeconds(const std::vector<const PatchEngine*>& engines) {
-  double s = 0;
-  for (const PatchEngine* engine : engines) {
-    for (const auto& [name, t] : engine->kernel_times()) s += t.seconds;
-  }
-  return s;
+  return sum;
 }
 
 // The colour at `uv` of an 8-bit BGR image, bilinear between the pixels
@@ -138,35 +131,22 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   };
   report("load");
   auto stage_start = std::chrono::steady_clock::now();
-  double device_before = 0;
-  double evaluations_before = 0;
+  KernelTime kernels_before;
   double cpu_before = ProcessCpuSeconds();
   std::vector<const PatchEngine*> engines;  // those launched so far
   auto end_stage = [&](const std::string& name) {
     StageTime t;
     t.wall = Seconds(stage_start);
-    const double device_now = DeviceSeconds(engines);
-    t.device = device_now - device_before;
+    const KernelTime kernels_now = KernelTotals(engines);
+    t.device = kernels_now.seconds - kernels_before.seconds;
+    t.ncc_evaluations = kernels_now.ncc_evaluations - kernels_before.ncc_evaluations;
+    kernels_before = kernels_now;
     const double cpu_now = ProcessCpuSeconds();
     t.cpu = cpu_now - cpu_before;
     cpu_before = cpu_now;
+    // The group's peak so far, which only grows: the later pass's is the higher.
     t.peak_rss_bytes = PeakRssBytes();
-    device_before = device_now;
-    const double evaluations_now = NccEvaluations(engines);
-    t.ncc_evaluations = evaluations_now - evaluations_before;
-    evaluations_before = evaluations_now;
-    // Stages repeated by the expand-filter passes add up under one name.
-    auto same = std::find_if(stats.stages.begin(), stats.stages.end(),
-                             [&](const auto& s) { return s.first == name; });
-    if (same == stats.stages.end()) {
-      stats.stages.emplace_back(name, t);
-    } else {
-      same->second.wall += t.wall;
-      same->second.device += t.device;
-      same->second.cpu += t.cpu;
-      same->second.ncc_evaluations += t.ncc_evaluations;
-      same->second.peak_rss_bytes = t.peak_rss_bytes;
-    }
+    AddStageTime(name, t, &stats.stages);
     stage_start = std::chrono::steady_clock::now();
   };
 

@@ -79,19 +79,7 @@ void AddStats(const MatchStats& s, MatchStats* sum) {
   sum->removed_depth_range += s.removed_depth_range;
   sum->removed_unfitted += s.removed_unfitted;
   sum->points += s.points;
-  for (const auto& [name, t] : s.stages) {
-    auto it = std::find_if(sum->stages.begin(), sum->stages.end(),
-                           [&](const auto& e) { return e.first == name; });
-    if (it == sum->stages.end()) {
-      sum->stages.emplace_back(name, t);
-    } else {
-      it->second.wall += t.wall;
-      it->second.device += t.device;
-      it->second.cpu += t.cpu;
-      it->second.ncc_evaluations += t.ncc_evaluations;
-      it->second.peak_rss_bytes = std::max(it->second.peak_rss_bytes, t.peak_rss_bytes);
-    }
-  }
+  for (const auto& [name, t] : s.stages) AddStageTime(name, t, &sum->stages);
   for (const auto& [name, k] : s.kernels) AddKernelTime(k, &sum->kernels[name]);
   sum->gsd = s.gsd;
 }

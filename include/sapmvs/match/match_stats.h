@@ -49,6 +49,24 @@ inline void AddKernelTime(const KernelTime& t, KernelTime* sum) {
   sum->max_seconds = std::max(sum->max_seconds, t.max_seconds);
 }
 
+// Adds t to the stage called `name` in *stages, or appends it: stages
+// repeated by the expand-filter passes, or over a run's groups, add up under
+// one name (the peak RSS: the higher).
+inline void AddStageTime(const std::string& name, const StageTime& t,
+                         std::vector<std::pair<std::string, StageTime>>* stages) {
+  auto same =
+      std::find_if(stages->begin(), stages->end(), [&](const auto& s) { return s.first == name; });
+  if (same == stages->end()) {
+    stages->emplace_back(name, t);
+    return;
+  }
+  same->second.wall += t.wall;
+  same->second.device += t.device;
+  same->second.cpu += t.cpu;
+  same->second.ncc_evaluations += t.ncc_evaluations;
+  same->second.peak_rss_bytes = std::max(same->second.peak_rss_bytes, t.peak_rss_bytes);
+}
+
 struct MatchStats {
   int images = 0;
   long features = 0;
