@@ -14,8 +14,12 @@ PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed, 
     const double wavelength = 0.8 + 2.2 * (0.5 + 0.5 * unit(rng));
     const double angle = kPi * unit(rng);
     const double kmag = 2.0 * kPi / wavelength;
-    scene.waves.emplace_back(kmag * std::cos(angle), kmag * std::sin(angle), kPi * unit(rng),
-                             8.0 + 4.0 * unit(rng));
+    // Named draws, last argument first: the order in which a call's
+    // arguments are evaluated is the compiler's, and these scenes must be
+    // the same from gcc and clang (gcc evaluated them last to first).
+    const double amplitude = 8.0 + 4.0 * unit(rng);
+    const double phase = kPi * unit(rng);
+    scene.waves.emplace_back(kmag * std::cos(angle), kmag * std::sin(angle), phase, amplitude);
   }
   // Georeferenced-looking world coordinates, translated to a local origin as
   // the block does; the texture and patches live in the local frame.
@@ -23,7 +27,9 @@ PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed, 
   const Intrinsics intrinsics = Intrinsics::FromPixels(150.0, 152.0, 0.5 * (width - 1) + 2.0,
                                                        0.5 * (height - 1) - 1.5, width, height);
   for (int i = 0; i < num_images; ++i) {
-    Eigen::Vector3d center(6.0 * unit(rng), 6.0 * unit(rng), 40.0 + 3.0 * unit(rng));
+    const double z = 40.0 + 3.0 * unit(rng);  // last to first, as the waves
+    const double y = 6.0 * unit(rng);
+    Eigen::Vector3d center(6.0 * unit(rng), y, z);
     if (strip_base > 0) {
       // 0, -b, +b, -2b, +2b, ... along x at 40 m: image 0 in the middle.
       const int step = (i + 1) / 2;
@@ -35,9 +41,12 @@ PlaneScene MakePlaneScene(int num_images, int width, int height, uint32_t seed, 
     r_cw.col(0) = Eigen::Vector3d(1, 0, 0);
     r_cw.col(1) = Eigen::Vector3d(0, -1, 0);
     r_cw.col(2) = Eigen::Vector3d(0, 0, -1);
-    const Eigen::Matrix3d tilt = (Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitX()) *
-                                  Eigen::AngleAxisd(0.2 * unit(rng), Eigen::Vector3d::UnitY()) *
-                                  Eigen::AngleAxisd(kPi * unit(rng), Eigen::Vector3d::UnitZ()))
+    const double yaw = kPi * unit(rng);  // last to first, as the waves
+    const double pitch = 0.2 * unit(rng);
+    const double roll = 0.2 * unit(rng);
+    const Eigen::Matrix3d tilt = (Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()) *
+                                  Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()))
                                      .toRotationMatrix();
     const Camera world(intrinsics, (tilt * r_cw).transpose(), center + origin);
     scene.cameras.push_back(world.Translated(origin));
@@ -88,8 +97,8 @@ std::vector<PlaneStart> PerturbedStarts(const PlaneScene& scene, int count, doub
   const Camera& ref = scene.cameras[0];
   std::vector<PlaneStart> starts;
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector2d uv(0.5 * (ref.width() - 1) + spread.x() * unit(rng),
-                             0.5 * (ref.height() - 1) + spread.y() * unit(rng));
+    const double v = 0.5 * (ref.height() - 1) + spread.y() * unit(rng);  // as in MakePlaneScene
+    const Eigen::Vector2d uv(0.5 * (ref.width() - 1) + spread.x() * unit(rng), v);
     const Eigen::Vector3d truth = GroundAt(ref, uv);
     const Eigen::Vector3d ray = (truth - ref.center()).normalized();
     const double footprint = ref.Depth(truth) / ref.intrinsics().MeanFocal();

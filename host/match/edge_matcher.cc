@@ -162,7 +162,10 @@ std::vector<EdgeMap> MatchEdges(const MatchGroupData& group, const MatcherOption
   for (int i = 0; i < n; ++i) {
     const MatchImage& ref = group.images[i];
     maps[i].matched = cv::Mat::zeros(ref.grey.size(), CV_8U);
-    const auto [dmin, dmax] = depth_range[i];
+    // Named copies, not a structured binding: clang cannot capture those in
+    // the OpenMP region below.
+    const double dmin = depth_range[i].first;
+    const double dmax = depth_range[i].second;
     if (ref.views.empty() || !(dmin < dmax)) continue;
     for (int y0 = margin; y0 < ref.grey.rows - margin; y0 += kEdgeRowsPerLaunch) {
       const int y1 = std::min(ref.grey.rows - margin, y0 + kEdgeRowsPerLaunch);

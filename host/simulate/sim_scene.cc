@@ -166,7 +166,11 @@ Scene Scene::Generate(const SceneSpec& spec, uint64_t seed) {
   for (int tries = 0; water_left > 0 && tries < 10; ++tries) {
     const double ra = std::sqrt(water_left / kPi) * (1.0 + 0.6 * uni(rng)),
                  rb = water_left / (kPi * ra);
-    const Eigen::Vector2d ctr(w * (0.15 + 0.7 * uni(rng)), h * (0.15 + 0.7 * uni(rng)));
+    // Drawn y first, in named steps: the order of a constructor's arguments
+    // is the compiler's, and the same seed must give the same scene from
+    // gcc and clang (gcc drew y first).
+    const double ctr_y = h * (0.15 + 0.7 * uni(rng));
+    const Eigen::Vector2d ctr(w * (0.15 + 0.7 * uni(rng)), ctr_y);
     const double ang = kPi * uni(rng);
     float level = std::numeric_limits<float>::max();
     Rect box{ctr, ra, rb, ang};
@@ -300,7 +304,8 @@ Scene Scene::Generate(const SceneSpec& spec, uint64_t seed) {
   const double crown_target = spec.tree_density * w * h;
   for (int tries = 0; crowns < crown_target && tries < 200000; ++tries) {
     const double rad = 2 + 3 * uni(rng);
-    const Eigen::Vector2d ctr(w * uni(rng), h * uni(rng));
+    const double ctr_y = h * uni(rng);  // y before x, as for the water above
+    const Eigen::Vector2d ctr(w * uni(rng), ctr_y);
     const Rect box{ctr, rad, rad, 0};
     if (!free_land(box, -rad * 0.3)) continue;
     const double top = 5 + 10 * uni(rng);

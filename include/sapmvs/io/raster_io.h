@@ -82,8 +82,10 @@ class GeoOutputsCheck {
  private:
   std::string crs_;
   std::string source_;
-  int child_ = -1;         // the checking process, in the binary
-  int child_stderr_ = -1;  // the read end of its stderr
+  // Only the binary's variant (host/cli/gdal_module.cc) has a child; the
+  // in-process one, linked into the tests, leaves them unused.
+  [[maybe_unused]] int child_ = -1;         // the checking process
+  [[maybe_unused]] int child_stderr_ = -1;  // the read end of its stderr
 };
 // The resident memory that loading GDAL to write the outputs will add: 0
 // where GDAL is linked in or already loaded, and in the binary, before it
