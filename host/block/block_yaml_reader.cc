@@ -143,8 +143,7 @@ Intrinsics ReadCamera(const YamlFile& f, const YAML::Node& node) {
 class ImageLocator {
  public:
   ImageLocator(const YamlFile& f, const YAML::Node& node, const fs::path& base,
-               const fs::path& override_dir)
-      : f_(f), node_(node) {
+               const fs::path& override_dir) {
     if (!override_dir.empty()) {
       folder_ = override_dir;
     } else if (node.IsScalar()) {
@@ -183,8 +182,6 @@ class ImageLocator {
   }
 
  private:
-  const YamlFile& f_;
-  YAML::Node node_;
   fs::path folder_;
   std::map<std::string, fs::path> by_stem_;
 };

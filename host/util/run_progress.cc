@@ -11,7 +11,6 @@ namespace sapmvs {
 RunProgress::RunProgress(int groups, long images, bool enabled, std::FILE* out)
     : enabled_(enabled && groups > 0),
       out_(out),
-      groups_(groups),
       images_(images),
       start_(std::chrono::steady_clock::now()),
       group_start_(start_),

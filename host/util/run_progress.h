@@ -39,7 +39,6 @@ class RunProgress {
 
   bool enabled_;
   std::FILE* out_;
-  int groups_;
   long images_, images_done_ = 0, group_images_ = 0;
   int index_ = 0, group_count_ = 0;
   double matched_seconds_ = 0;  // of the groups ended
