@@ -11,8 +11,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # `mpirun -np N sapmvs run` (optional: without them sapmvs builds as one process).
   openmpi-bin libopenmpi-dev
-  # scripts/fuzz.sh: clang with its sanitizer and libFuzzer runtimes and its
-  # OpenMP; the symbolizer for sanitizer reports (also test.sh --sanitize).
+  # scripts/fuzz.sh and test.sh --sanitize: clang with its sanitizer and
+  # libFuzzer runtimes and its OpenMP; the symbolizer for sanitizer reports.
   clang libclang-rt-14-dev libomp-dev llvm
 )
 

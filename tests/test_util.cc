@@ -57,10 +57,12 @@ void RemoveStaleCaches(const fs::path& keep) {
 
 }  // namespace
 
-fs::path SharedFolder(const std::string& id, const std::function<void(const fs::path&)>& make) {
+fs::path SharedFolder(const std::string& id, const std::function<void(const fs::path&)>& make,
+                      const fs::path& root) {
   static std::map<std::string, fs::path> made;
   if (auto it = made.find(id); it != made.end()) return it->second;
-  const fs::path cache = fs::temp_directory_path() / ("sapmvs_sim_cache_" + BuildKey());
+  const fs::path cache =
+      root.empty() ? fs::temp_directory_path() / ("sapmvs_sim_cache_" + BuildKey()) : root;
   fs::create_directories(cache);
   const fs::path dir = cache / id;
   // Made in place (a run's files name their folder) and marked done beside it.
@@ -72,7 +74,7 @@ fs::path SharedFolder(const std::string& id, const std::function<void(const fs::
       fs::remove_all(dir);
       make(dir);
       std::ofstream(done).put('\n');
-      RemoveStaleCaches(cache);
+      if (root.empty()) RemoveStaleCaches(cache);
     }
   } catch (...) {
     ::close(lock);
@@ -96,11 +98,15 @@ SimulateOptions SimulatedOptions(const std::string& preset, int seed, double sca
 fs::path Simulated(const std::string& preset, int seed, double scale) {
   std::ostringstream id;
   id << preset << "_seed" << seed << "_scale" << scale;
-  return SharedFolder(id.str(), [&](const fs::path& dir) {
-    SimulateOptions o = SimulatedOptions(preset, seed, scale);
-    o.out = dir;
-    Simulate(o);
-  });
+  const char* shared = std::getenv("SAPMVS_SIM_CACHE");
+  return SharedFolder(
+      id.str(),
+      [&](const fs::path& dir) {
+        SimulateOptions o = SimulatedOptions(preset, seed, scale);
+        o.out = dir;
+        Simulate(o);
+      },
+      shared && *shared ? fs::path(shared) : fs::path());
 }
 
 bool OpenClRequired() {

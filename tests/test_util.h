@@ -62,9 +62,11 @@ class ScopedEnv {
 // a per-process cache would remake it for every test. Kept in the temp folder
 // under a lock (the other processes of a parallel ctest wait), keyed by `id`
 // and by this build's sapmvs binary; a folder whose `make` did not finish is
-// made again.
+// made again. `root`, where given, replaces the temp folder and the build's
+// key: the folder is then shared by every build that names that root.
 std::filesystem::path SharedFolder(const std::string& id,
-                                   const std::function<void(const std::filesystem::path&)>& make);
+                                   const std::function<void(const std::filesystem::path&)>& make,
+                                   const std::filesystem::path& root = {});
 
 // The options Simulated() runs the simulator with (quiet, truth/lidar.xyz
 // too), without `out`: a test can rebuild the same world or render the same
@@ -73,7 +75,9 @@ SimulateOptions SimulatedOptions(const std::string& preset, int seed, double sca
 // The simulator's `preset` rendered with `seed` at `scale` (a SharedFolder).
 // Read only: a test that needs a changed block copies it. The simulator is
 // the slowest thing the sanitizer build runs, so tests share these folders
-// rather than simulate their own.
+// rather than simulate their own. With SAPMVS_SIM_CACHE set, the blocks are
+// kept there for every build of the same sources: the scenes are the same
+// bytes from gcc and clang, so CI's two builds render each block once.
 std::filesystem::path Simulated(const std::string& preset, int seed, double scale = 1.0);
 
 // Kernel-versus-reference comparison: |actual - expected| <= abs_tol + rel_tol
