@@ -101,16 +101,17 @@ struct Row {
   std::optional<double> matching_busy;
 };
 
-// CPU / wall over the matching stages of a sapmvs run's report.json, the
-// stages with cpu_seconds (the run's own "run ..." stages have none); none
-// when the binary does not record CPU time.
+// CPU / wall over the matching stages of a sapmvs run's report.json: the
+// stages with cpu_seconds, less the run's own ("run merge", ...; older
+// binaries timed only the matching stages); none when the binary does not
+// record CPU time.
 std::optional<double> MatchingBusy(const fs::path& report) {
   std::ifstream f(report);
   const nlohmann::json j = nlohmann::json::parse(f, nullptr, false);
   if (j.is_discarded() || !j.contains("stages")) return std::nullopt;
   double wall = 0, cpu = 0;
   for (const nlohmann::json& s : j["stages"]) {
-    if (!s.contains("cpu_seconds")) continue;
+    if (!s.contains("cpu_seconds") || s.value("stage", "").rfind("run ", 0) == 0) continue;
     wall += s["wall_seconds"].get<double>();
     cpu += s["cpu_seconds"].get<double>();
   }

@@ -33,7 +33,7 @@ RunReport MadeUpReport() {
   r.stats.kernels["patch_refine 21x21"] = refine;
   r.stats.stages = {{"load", {1.0, 0.0, 1.0}}, {"propagation", {3.0, 2.5, 5.4, 0, 5350}}};
   r.points = 1000;
-  r.stages = {{"plan", 0.5}, {"match", 4.0}, {"merge", 2.0}};
+  r.stages = {{"plan", 0.5, 0.4}, {"match", 4.0, 7.0}, {"merge", 2.0, 3.8}};
   return r;
 }
 
@@ -74,13 +74,18 @@ TEST(RunProfile, PhasesSortedByWallWithHostTime) {
   for (size_t i = 1; i < p.size(); ++i) EXPECT_GE(p[i - 1].wall, p[i].wall);
 }
 
-TEST(RunProfile, MatchingPhasesSayHowBusyTheyKeptTheCores) {
+TEST(RunProfile, PhasesSayHowBusyTheyKeptTheCores) {
   std::ostringstream out;
   PrintProfile(MadeUpReport(), out);
   const std::string text = out.str();
-  // propagation 5.4 / 3.0 s; the matching, (1.0 + 5.4) / (1.0 + 3.0) s.
+  // propagation 5.4 / 3.0 s; the matching, (1.0 + 5.4) / (1.0 + 3.0) s,
+  // without the run's own stages; the merge 3.8 / 2.0 s.
   EXPECT_NE(text.find("1.80"), std::string::npos) << text;
   EXPECT_NE(text.find("matching 4.000 s wall, CPU/wall 1.60"), std::string::npos) << text;
+  const size_t merge = text.find("run merge");
+  ASSERT_NE(merge, std::string::npos) << text;
+  const std::string merge_line = text.substr(merge, text.find('\n', merge) - merge);
+  EXPECT_NE(merge_line.find(" 1.90 "), std::string::npos) << merge_line;
 }
 
 TEST(RunProfile, PhasesCountTheWorkPerPoint) {

@@ -32,6 +32,7 @@
 #include "sapmvs/run/cloud_merge.h"
 #include "sapmvs/run/dsm_picture.h"
 #include "sapmvs/util/byte_size.h"
+#include "sapmvs/util/cpu_time.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/log.h"
 #include "sapmvs/util/memory_use.h"
@@ -105,10 +106,13 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   report.out = options.out;
   report.start_time = std::chrono::system_clock::now();
   auto stage_start = start;
+  double stage_cpu = ProcessCpuSeconds();
   auto end_stage = [&](const std::string& name) {
-    report.stages.emplace_back(name, Since(stage_start));
-    LogDetail("run: " + name + " " + Seconds(report.stages.back().second));
+    const double cpu = ProcessCpuSeconds();
+    report.stages.push_back({name, Since(stage_start), cpu - stage_cpu});
+    LogDetail("run: " + name + " " + Seconds(report.stages.back().wall));
     stage_start = std::chrono::steady_clock::now();
+    stage_cpu = cpu;
   };
 
   const Block block = ReadBlock(options.block, options.read);
@@ -349,10 +353,12 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
       out << ", peak " << std::lround(t.peak_rss_bytes / (1 << 20)) << " MiB";
     out << "\n";
   }
-  for (const auto& [name, t] : report.stages) {
-    if (name == "match") continue;
-    out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t
-        << " s wall\n";
+  for (const RunReport::Stage& t : report.stages) {
+    if (t.name == "match") continue;
+    out << "time " << std::left << std::setw(12) << t.name << std::right << std::setw(8) << t.wall
+        << " s wall";
+    if (t.wall > 0 && t.cpu > 0) out << ", CPU/wall " << t.cpu / t.wall;
+    out << "\n";
   }
   if (!report.finished) {
     out << "stopped       after the groups asked for; run again to resume\n";

@@ -46,9 +46,9 @@ std::vector<PhaseProfile> ProfilePhases(const RunReport& report) {
   for (const auto& [name, t] : report.stats.stages) {
     out.push_back({name, t.wall, t.device, t.cpu, t.ncc_evaluations});
   }
-  for (const auto& [name, wall] : report.stages) {
-    if (name == "match") continue;  // the stages above, summed
-    out.push_back({"run " + name, wall, 0});
+  for (const RunReport::Stage& t : report.stages) {
+    if (t.name == "match") continue;  // the stages above, summed
+    out.push_back({"run " + t.name, t.wall, 0, t.cpu});
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const PhaseProfile& a, const PhaseProfile& b) { return a.wall > b.wall; });
@@ -87,8 +87,8 @@ void PrintProfile(const RunReport& report, std::ostream& out) {
   // The work per output point: NCC evaluations of one window in one view
   // pair, per point of the cloud, which device speed and clock do not change.
   const double points = static_cast<double>(report.points);
-  out << "\nprofile: phases, by wall time (host = wall - device; CPU/wall of the matching"
-         " phases; NCC evaluations per point of the cloud)\n";
+  out << "\nprofile: phases, by wall time (host = wall - device; CPU/wall: the process's CPU"
+         " time over the phase's wall; NCC evaluations per point of the cloud)\n";
   std::snprintf(line, sizeof line, "%-18s %10s %10s %10s %7s %9s %10s\n", "phase", "wall s",
                 "device s", "host s", "share", "CPU/wall", "NCC/point");
   out << line;
@@ -102,7 +102,7 @@ void PrintProfile(const RunReport& report, std::ostream& out) {
                   report.total_seconds > 0 ? 100 * p.wall / report.total_seconds : 0.0,
                   busy.c_str(), work.c_str());
     out << line;
-    if (p.cpu > 0) {
+    if (p.cpu > 0 && p.phase.rfind("run ", 0) != 0) {  // the matching phases
       match_wall += p.wall;
       match_cpu += p.cpu;
     }

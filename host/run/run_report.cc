@@ -168,8 +168,11 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   // device time), then the run's own: plan, match (all groups), merge, ...
   nlohmann::json matching = MatchStatsJson(report.stats, options.profile);
   nlohmann::json stages = matching["stages"];
-  for (const auto& [name, t] : report.stages) {
-    stages.push_back({{"stage", "run " + name}, {"wall_seconds", t}, {"hms", FormatHms(t)}});
+  for (const RunReport::Stage& t : report.stages) {
+    stages.push_back({{"stage", "run " + t.name},
+                      {"wall_seconds", t.wall},
+                      {"cpu_seconds", t.cpu},
+                      {"hms", FormatHms(t.wall)}});
   }
   j["stages"] = stages;
   j["kernels"] = matching["kernels"];

@@ -76,7 +76,15 @@ struct RunReport {
   Eigen::Vector3d bounds_max = Eigen::Vector3d::Zero();
   double total_seconds = 0;
   double peak_rss_bytes = 0;
-  std::vector<std::pair<std::string, double>> stages;  // wall seconds, this call
+  // The run's own stages in this call (plan, match, merge, statistics,
+  // write): wall seconds, and the process's CPU seconds over the same span,
+  // all threads, so that a stage that keeps one core busy shows.
+  struct Stage {
+    std::string name;
+    double wall = 0;
+    double cpu = 0;
+  };
+  std::vector<Stage> stages;
 };
 
 // Seconds as h:min:s, as the paper's tables give run times.
