@@ -344,20 +344,18 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
     out << "\n";
   }
   out << std::fixed << std::setprecision(2);
-  for (const auto& [name, t] : s.stages) {
+  // The matching stages, then the run's own (its "match" is those summed).
+  std::vector<std::pair<std::string, StageTime>> lines = s.stages;
+  for (const RunReport::Stage& t : report.stages) {
+    if (t.name != "match") lines.emplace_back(t.name, StageTime{t.wall, 0, t.cpu});
+  }
+  for (const auto& [name, t] : lines) {
     out << "time " << std::left << std::setw(12) << name << std::right << std::setw(8) << t.wall
         << " s wall";
     if (t.device > 0) out << ", " << t.device << " s in kernels";
     if (t.wall > 0 && t.cpu > 0) out << ", CPU/wall " << t.cpu / t.wall;
     if (t.peak_rss_bytes > 0)
       out << ", peak " << std::lround(t.peak_rss_bytes / (1 << 20)) << " MiB";
-    out << "\n";
-  }
-  for (const RunReport::Stage& t : report.stages) {
-    if (t.name == "match") continue;
-    out << "time " << std::left << std::setw(12) << t.name << std::right << std::setw(8) << t.wall
-        << " s wall";
-    if (t.wall > 0 && t.cpu > 0) out << ", CPU/wall " << t.cpu / t.wall;
     out << "\n";
   }
   if (!report.finished) {

@@ -102,11 +102,15 @@ void PrintProfile(const RunReport& report, std::ostream& out) {
                   report.total_seconds > 0 ? 100 * p.wall / report.total_seconds : 0.0,
                   busy.c_str(), work.c_str());
     out << line;
-    if (p.cpu > 0 && p.phase.rfind("run ", 0) != 0) {  // the matching phases
-      match_wall += p.wall;
-      match_cpu += p.cpu;
-    }
     evaluations += p.ncc_evaluations;
+  }
+  // The matching as a whole: its stages, which time their CPU (not the
+  // run's own around them).
+  for (const auto& [name, t] : report.stats.stages) {
+    if (t.cpu > 0) {
+      match_wall += t.wall;
+      match_cpu += t.cpu;
+    }
   }
   if (evaluations > 0 && points > 0) {
     out << "work " << F("%.4g", evaluations) << " NCC evaluations, "
