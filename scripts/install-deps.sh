@@ -1,7 +1,24 @@
 #!/usr/bin/env bash
 # Installs the Debian packages sapmvs builds and runs with. Idempotent: packages
 # already present are left alone, so a second run only costs the apt checks.
+#
+#   scripts/install-deps.sh           everything: building, the tests, the
+#                                     sanitizer and fuzzing toolchain, and the
+#                                     npm LAS readers the tests compare with
+#   scripts/install-deps.sh --build   only what building and running sapmvs
+#                                     needs (scripts/demo.sh): on a fresh
+#                                     Debian 12 machine clang, LLVM and the npm
+#                                     packages were 40 s of the demo's 6 min
 set -euo pipefail
+build_only=0
+case "${1:-}" in
+  "") ;;
+  --build) build_only=1 ;;
+  *)
+    echo "install-deps: unknown argument '$1'; expected none or --build" >&2
+    exit 2
+    ;;
+esac
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
@@ -11,10 +28,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # `mpirun -np N sapmvs run` (optional: without them sapmvs builds as one process).
   openmpi-bin libopenmpi-dev
-  # scripts/fuzz.sh and test.sh --sanitize: clang with its sanitizer and
-  # libFuzzer runtimes and its OpenMP; the symbolizer for sanitizer reports.
-  clang libclang-rt-14-dev libomp-dev llvm
 )
+# scripts/fuzz.sh and test.sh --sanitize: clang with its sanitizer and
+# libFuzzer runtimes and its OpenMP; the symbolizer for sanitizer reports.
+[ "$build_only" = 1 ] || PACKAGES+=(clang libclang-rt-14-dev libomp-dev llvm)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -30,6 +47,7 @@ else
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
   echo "install-deps: done"
 fi
+[ "$build_only" = 0 ] || exit 0
 
 # The independent LAS readers the tests check cloud.las with, from npm: copc.js
 # and @loaders.gl/las (the loader behind deck.gl and kepler.gl; @loaders.gl/las
