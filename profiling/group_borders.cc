@@ -26,6 +26,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "sapmvs/block/block_geometry.h"
@@ -63,8 +64,8 @@ std::array<double, 3> Quantiles(std::vector<double>& v) {
   return q;
 }
 
-// The DSM steps (see the top of this file) of `dsm`, printed.
-void PrintDsmSteps(const GeoRaster& dsm, const std::vector<Eigen::Vector2d>& centers) {
+// Each DSM cell's group core (CoreOwner of `centers`), -1 where empty.
+std::vector<int> CellOwners(const GeoRaster& dsm, const std::vector<Eigen::Vector2d>& centers) {
   std::vector<int> owner(dsm.values.size(), -1);
   for (int r = 0; r < dsm.height; ++r) {
     for (int c = 0; c < dsm.width; ++c) {
@@ -73,24 +74,61 @@ void PrintDsmSteps(const GeoRaster& dsm, const std::vector<Eigen::Vector2d>& cen
       owner[static_cast<size_t>(r) * dsm.width + c] = CoreOwner(centers, p.x(), p.y());
     }
   }
-  std::vector<double> across, inside;
+  return owner;
+}
+
+// f(a, b, |dz|) for every two filled cells side by side, a and b their
+// cell indices.
+template <typename F>
+void ForEachStep(const GeoRaster& dsm, const F& f) {
   for (int r = 0; r < dsm.height; ++r) {
     for (int c = 0; c < dsm.width; ++c) {
-      const int a = owner[static_cast<size_t>(r) * dsm.width + c];
-      if (a < 0) continue;
+      if (dsm.IsEmpty(c, r)) continue;
       for (const auto& [dc, dr] : {std::pair{1, 0}, std::pair{0, 1}}) {
-        if (c + dc >= dsm.width || r + dr >= dsm.height) continue;
-        const int b = owner[static_cast<size_t>(r + dr) * dsm.width + c + dc];
-        if (b < 0) continue;
-        const double dz = std::abs(double(dsm.at(c, r)) - dsm.at(c + dc, r + dr));
-        (a == b ? inside : across).push_back(dz);
+        if (c + dc >= dsm.width || r + dr >= dsm.height || dsm.IsEmpty(c + dc, r + dr)) continue;
+        f(static_cast<size_t>(r) * dsm.width + c, static_cast<size_t>(r + dr) * dsm.width + c + dc,
+          std::abs(double(dsm.at(c, r)) - dsm.at(c + dc, r + dr)));
       }
     }
   }
+}
+
+// The DSM steps (see the top of this file) of `dsm`, printed. The control
+// row: the same borders moved by half the median distance between
+// neighbouring group centres (four ways, pooled), where they cut through
+// groups' cores: the steps of lines of the same length and shape where no
+// groups meet, whose spread says how far the real row may differ by chance
+// (a few thousand pairs along a few lines, through trees or over roofs).
+void PrintDsmSteps(const GeoRaster& dsm, const std::vector<Eigen::Vector2d>& centers) {
+  const std::vector<int> owner = CellOwners(dsm, centers);
+  std::vector<double> across, inside;
+  ForEachStep(dsm, [&](size_t a, size_t b, double dz) {
+    (owner[a] == owner[b] ? inside : across).push_back(dz);
+  });
+  std::vector<double> nearest;
+  for (size_t g = 0; g < centers.size(); ++g) {
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t h = 0; h < centers.size(); ++h) {
+      if (h != g) best = std::min(best, (centers[g] - centers[h]).norm());
+    }
+    nearest.push_back(best);
+  }
+  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+  const double shift = 0.5 * nearest[nearest.size() / 2];
+  std::vector<double> control;
+  for (const Eigen::Vector2d d : {Eigen::Vector2d(shift, 0), Eigen::Vector2d(-shift, 0),
+                                  Eigen::Vector2d(0, shift), Eigen::Vector2d(0, -shift)}) {
+    std::vector<Eigen::Vector2d> moved = centers;
+    for (Eigen::Vector2d& c : moved) c += d;
+    const std::vector<int> fake = CellOwners(dsm, moved);
+    ForEachStep(dsm, [&](size_t a, size_t b, double dz) {
+      if (owner[a] == owner[b] && fake[a] != fake[b]) control.push_back(dz);
+    });
+  }
   std::cout << "DSM steps (cell " << dsm.cell_size << "): neighbouring cells' |dz|\n"
             << "pairs              count     median        p90        p99\n";
-  const std::pair<const char*, std::vector<double>*> sets[] = {{"inside groups", &inside},
-                                                               {"across borders", &across}};
+  const std::pair<const char*, std::vector<double>*> sets[] = {
+      {"inside groups", &inside}, {"across borders", &across}, {"control", &control}};
   for (const auto& [name, v] : sets) {
     const std::array<double, 3> q = Quantiles(*v);
     std::cout << std::left << std::setw(14) << name << std::right << std::setw(10) << v->size()
