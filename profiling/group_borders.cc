@@ -116,8 +116,8 @@ void PrintDsmSteps(const GeoRaster& dsm, const std::vector<Eigen::Vector2d>& cen
   std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
   const double shift = 0.5 * nearest[nearest.size() / 2];
   std::vector<double> control;
-  for (const Eigen::Vector2d d : {Eigen::Vector2d(shift, 0), Eigen::Vector2d(-shift, 0),
-                                  Eigen::Vector2d(0, shift), Eigen::Vector2d(0, -shift)}) {
+  for (const Eigen::Vector2d& d : {Eigen::Vector2d(shift, 0), Eigen::Vector2d(-shift, 0),
+                                   Eigen::Vector2d(0, shift), Eigen::Vector2d(0, -shift)}) {
     std::vector<Eigen::Vector2d> moved = centers;
     for (Eigen::Vector2d& c : moved) c += d;
     const std::vector<int> fake = CellOwners(dsm, moved);
