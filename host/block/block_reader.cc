@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "block/block_georeference.h"
 #include "sapmvs/block/image_io.h"
 #include "sapmvs/util/error.h"
 #include "util/input_file.h"
@@ -74,6 +75,13 @@ std::string BlockReadOptions::Problem() const {
     std::ostringstream s;
     s << "a finite ground height (ground_height = " << *ground_height << ")";
     return s.str();
+  }
+  if (enu_origin) {
+    GeoReference g;
+    g.latitude = enu_origin->x();
+    g.longitude = enu_origin->y();
+    g.altitude = enu_origin->z();
+    if (const std::string p = g.Problem(); !p.empty()) return "an ENU origin with " + p;
   }
   return "";
 }
@@ -195,6 +203,7 @@ Block ReadBlock(const fs::path& path, const BlockReadOptions& options) {
       }
     }
   }
+  ApplyFrame(options, &block);
   block.origin = ChooseLocalOrigin(block.images);
   return block;
 }

@@ -41,6 +41,24 @@ std::string GeoReference::Problem() const {
   return s.str();
 }
 
+GeoReference GeodeticOf(const Eigen::Vector3d& ecef) {
+  GeoReference g;
+  const double p = std::hypot(ecef.x(), ecef.y());
+  double lat = std::atan2(ecef.z(), p * (1 - kE2));
+  double h = 0;
+  // Bowring's iteration; five rounds reach a millimetre at any height a
+  // camera flies.
+  for (int i = 0; i < 5; ++i) {
+    const double n = kSemiMajor / std::sqrt(1 - kE2 * std::sin(lat) * std::sin(lat));
+    h = p / std::cos(lat) - n;
+    lat = std::atan2(ecef.z(), p * (1 - kE2 * n / (n + h)));
+  }
+  g.latitude = lat * 180 / kPi;
+  g.longitude = std::atan2(ecef.y(), ecef.x()) * 180 / kPi;
+  g.altitude = h;
+  return g;
+}
+
 int UtmEpsgFor(const GeoReference& point) {
   const int zone = std::clamp(static_cast<int>(std::floor((point.longitude + 180) / 6)) + 1, 1, 60);
   return (point.latitude >= 0 ? 32600 : 32700) + zone;

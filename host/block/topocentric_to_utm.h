@@ -38,6 +38,9 @@ struct GeoReference {
   std::string Problem() const;
 };
 
+// The geodetic coordinates (WGS84) of an ECEF point.
+GeoReference GeodeticOf(const Eigen::Vector3d& ecef);
+
 // The UTM zone of a point from its longitude alone (no Norway or Svalbard
 // exceptions): EPSG 326zz north of the equator, 327zz south.
 int UtmEpsgFor(const GeoReference& point);
@@ -52,6 +55,10 @@ class TopocentricToUtm {
   TopocentricToUtm& operator=(const TopocentricToUtm&) = delete;
 
   int epsg() const { return epsg_; }
+  // The reference point in ECEF, and the ENU axes there as columns in ECEF:
+  // X_ecef = origin_ecef() + enu_to_ecef() * X_enu, exactly.
+  const Eigen::Vector3d& origin_ecef() const { return origin_ecef_; }
+  const Eigen::Matrix3d& enu_to_ecef() const { return enu_to_ecef_; }
 
   // Exact, in place: ENU metres to UTM easting, northing and height.
   void Transform(std::vector<Eigen::Vector3d>* points) const;

@@ -8,6 +8,9 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "cli/cli.h"
 #include "sapmvs/block/block_geometry.h"
@@ -134,12 +137,39 @@ void AddBlockFlags(CLI::App* cmd, BlockFlags* flags, const std::string& format_f
                 "Do not compare image headers with the camera sizes");
   cmd->add_option("--ground-height", flags->ground_height,
                   "Mean ground height (block units) for blocks that carry no surface estimate");
+  cmd->add_option("--crs", flags->read.crs,
+                  "CRS of a block already in projected coordinates that does not name it "
+                  "(EPSG:n, WKT or a PROJ string)");
+  cmd->add_option("--enu-origin", flags->enu_origin,
+                  "LAT,LON,H: the origin of a block in a local east-north-up frame (COLMAP "
+                  "aligned to ENU); outputs go to the UTM zone there");
 }
 
 BlockReadOptions ReadOptionsOf(const BlockFlags& flags) {
   BlockReadOptions read = flags.read;
   read.format = ParseBlockFormat(flags.format);
   if (!std::isnan(flags.ground_height)) read.ground_height = flags.ground_height;
+  if (!flags.enu_origin.empty()) {
+    std::vector<double> v;
+    bool numbers = true;
+    std::stringstream in(flags.enu_origin);
+    for (std::string part; std::getline(in, part, ',');) {
+      size_t used = 0;
+      double x = std::numeric_limits<double>::quiet_NaN();
+      try {
+        x = std::stod(part, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      v.push_back(x);
+      numbers = numbers && used > 0 && used == part.size() && std::isfinite(x);
+    }
+    if (!numbers || v.size() != 3) {
+      throw Error("--enu-origin " + flags.enu_origin +
+                  ": expected LAT,LON,H (degrees, degrees, metres), e.g. 47.3769,8.5417,408");
+    }
+    read.enu_origin = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
   return read;
 }
 

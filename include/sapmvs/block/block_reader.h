@@ -9,6 +9,7 @@
 //   strecha  Strecha .camera files (K, distortion, R camera-to-world, C, W H)
 //   opensfm  OpenSfM reconstruction.json (perspective, brown)
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -34,6 +35,17 @@ struct BlockReadOptions {
   // Mean ground height, block units, replacing the block's own; for blocks
   // that carry no surface estimate. Finite.
   std::optional<double> ground_height;
+  // The CRS of a block that is already projected but does not say so (a
+  // COLMAP model aligned to UTM coordinates): WKT, "EPSG:n" or a PROJ
+  // string. A block that names another CRS is refused.
+  std::string crs;
+  // The geodetic origin (latitude, longitude in degrees, WGS84; height in
+  // metres) of a block in a local east-north-up frame about it (COLMAP's
+  // model_aligner to ENU): the block is moved into the UTM zone there, as
+  // an OpenSfM block is. A block whose camera centres lie at the Earth's
+  // radius and which looks at the Earth's centre is read as ECEF (model
+  // aligner to ECEF) and moved the same way without it.
+  std::optional<Eigen::Vector3d> enu_origin;
 
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
