@@ -12,7 +12,6 @@
 namespace sapmvs {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // WGS84, the ellipsoid of EPSG:4978/4979 and of OpenSfM's own conversion.
 constexpr double kSemiMajor = 6378137.0;
 constexpr double kFlattening = 1.0 / 298.257223563;
@@ -21,7 +20,7 @@ constexpr double kE2 = kFlattening * (2 - kFlattening);
 // worst corner of a block, few enough to cost nothing beside the matching.
 constexpr size_t kMaxCheckedPoints = 2000;
 
-double Radians(double deg) { return deg * kPi / 180.0; }
+double Radians(double deg) { return deg * M_PI / 180.0; }
 
 }  // namespace
 
@@ -53,8 +52,8 @@ GeoReference GeodeticOf(const Eigen::Vector3d& ecef) {
     h = p / std::cos(lat) - n;
     lat = std::atan2(ecef.z(), p * (1 - kE2 * n / (n + h)));
   }
-  g.latitude = lat * 180 / kPi;
-  g.longitude = std::atan2(ecef.y(), ecef.x()) * 180 / kPi;
+  g.latitude = lat * 180 / M_PI;
+  g.longitude = std::atan2(ecef.y(), ecef.x()) * 180 / M_PI;
   g.altitude = h;
   return g;
 }
@@ -137,7 +136,7 @@ TopocentricToUtmReport MoveTopocentricToUtm(const GeoReference& reference, Block
   const Eigen::Matrix3d r = map.LocalRotation(centre, &report.scale);
   // Grid north (UTM +Y) seen from ENU: its east component is the convergence.
   const Eigen::Vector3d grid_north = r.transpose() * Eigen::Vector3d::UnitY();
-  report.convergence_deg = std::atan2(grid_north.x(), grid_north.y()) * 180 / kPi;
+  report.convergence_deg = std::atan2(grid_north.x(), grid_north.y()) * 180 / M_PI;
 
   const std::vector<BlockImage> enu_images = block->images;
   std::vector<Eigen::Vector3d> centres;
