@@ -562,5 +562,23 @@ TEST(EvaluateOptionsTest, DefaultsAreValidAndEveryBoundaryIsChecked) {
             std::string::npos);
 }
 
+// The tolerance is printed in the CRS's vertical unit (metres for a
+// geographic CRS), and a cloud without CRS says its frame is local.
+TEST(PrintEvaluationTable, TheToleranceSaysItsUnit) {
+  for (const auto& [unit, want] :
+       {std::pair<std::string, std::string>{"", "(local frame units)"},
+        std::pair<std::string, std::string>{"m", "(m)"},
+        std::pair<std::string, std::string>{"deg", "(m)"},
+        std::pair<std::string, std::string>{"US survey foot", "(US survey foot)"}}) {
+    EvaluationReport r;
+    r.unit = unit;
+    r.tolerance = 1;
+    std::ostringstream out;
+    PrintEvaluationTable(r, out);
+    EXPECT_NE(out.str().find("tolerance     1 " + want), std::string::npos) << out.str();
+    EXPECT_EQ(out.str().find("CRS units"), std::string::npos) << out.str();
+  }
+}
+
 }  // namespace
 }  // namespace sapmvs

@@ -50,9 +50,9 @@ double NiceCeil(double v) {
   return 10 * p;
 }
 
-// " (m)" for axis labels; CRS units when the inputs had no CRS.
+// " (m)" for axis labels; the local frame's units when the inputs had no CRS.
 std::string Unit(const EvaluationReport& r, bool vertical) {
-  if (r.unit.empty()) return " (CRS units)";
+  if (r.unit.empty()) return " (local frame units)";
   return " (" + (vertical && r.unit == "deg" ? std::string("m") : r.unit) + ")";
 }
 
@@ -266,7 +266,7 @@ cv::Mat ErrorMap(const EvaluationReport& r, double range) {
   Text(&img, "dz" + Unit(r, true), x0 - 10, kMarginTop - 10);
   Text(&img,
        "mean dz per " + FormatPrintf("%.3g", dz.f / frame.scale) + " " +
-           (r.unit.empty() ? "CRS units" : r.unit) + " cell, clipped to +-" +
+           (r.unit.empty() ? "local frame units" : r.unit) + " cell, clipped to +-" +
            FormatPrintf("%g", range),
        kMarginLeft, 22, 0.55);
   Text(&img, "dark grey: no reference height", kMarginLeft, 44);

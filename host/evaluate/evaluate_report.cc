@@ -45,7 +45,11 @@ void PrintEvaluationTable(const EvaluationReport& r, std::ostream& out) {
         << r.dsm_height << " cells of " << FmtOrDash("%.4g", r.dsm_cell_size) << ", "
         << r.reference_points << " non-empty; heights bilinear between cell centres\n";
   }
-  out << "tolerance     " << FmtOrDash("%g", r.tolerance) << " (CRS units)\n";
+  // Vertical: metres also for a geographic CRS.
+  const std::string unit = r.unit.empty()    ? "local frame units"
+                           : r.unit == "deg" ? std::string("m")
+                                             : r.unit;
+  out << "tolerance     " << FmtOrDash("%g", r.tolerance) << " (" << unit << ")\n";
   out << "no reference  " << r.without_reference << " of " << r.cloud_points << " points ("
       << Percent(r.without_reference, r.cloud_points) << ") "
       << (lidar ? "have no LiDAR point within d" : "lie outside the DSM or next to empty cells")
