@@ -48,7 +48,7 @@ struct BlockFlags {
   std::string format = "auto";
   BlockReadOptions read;
   double ground_height = std::numeric_limits<double>::quiet_NaN();
-  std::string enu_origin;  // "LAT,LON,H", parsed by ReadOptionsOf
+  std::vector<double> enu_origin;  // LAT,LON,H; empty when not given
 };
 // `format_flag` names the block format's flag: "--input-format" where
 // --format names what a subcommand writes (export).

@@ -8,9 +8,7 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <string>
-#include <vector>
 
 #include "cli/cli.h"
 #include "sapmvs/block/block_geometry.h"
@@ -142,7 +140,10 @@ void AddBlockFlags(CLI::App* cmd, BlockFlags* flags, const std::string& format_f
                   "(EPSG:n, WKT or a PROJ string)");
   cmd->add_option("--enu-origin", flags->enu_origin,
                   "LAT,LON,H: the origin of a block in a local east-north-up frame (COLMAP "
-                  "aligned to ENU); outputs go to the UTM zone there");
+                  "aligned to ENU); outputs go to the UTM zone there (write --enu-origin=... "
+                  "when LAT is negative)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
 }
 
 BlockReadOptions ReadOptionsOf(const BlockFlags& flags) {
@@ -150,25 +151,13 @@ BlockReadOptions ReadOptionsOf(const BlockFlags& flags) {
   read.format = ParseBlockFormat(flags.format);
   if (!std::isnan(flags.ground_height)) read.ground_height = flags.ground_height;
   if (!flags.enu_origin.empty()) {
-    std::vector<double> v;
-    bool numbers = true;
-    std::stringstream in(flags.enu_origin);
-    for (std::string part; std::getline(in, part, ',');) {
-      size_t used = 0;
-      double x = std::numeric_limits<double>::quiet_NaN();
-      try {
-        x = std::stod(part, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      v.push_back(x);
-      numbers = numbers && used > 0 && used == part.size() && std::isfinite(x);
+    if (flags.enu_origin.size() != 3) {
+      throw Error("--enu-origin has " + std::to_string(flags.enu_origin.size()) +
+                  " values; expected LAT,LON,H (degrees, degrees, metres), e.g. "
+                  "47.3769,8.5417,408");
     }
-    if (!numbers || v.size() != 3) {
-      throw Error("--enu-origin " + flags.enu_origin +
-                  ": expected LAT,LON,H (degrees, degrees, metres), e.g. 47.3769,8.5417,408");
-    }
-    read.enu_origin = Eigen::Vector3d(v[0], v[1], v[2]);
+    read.enu_origin =
+        Eigen::Vector3d(flags.enu_origin[0], flags.enu_origin[1], flags.enu_origin[2]);
   }
   return read;
 }
