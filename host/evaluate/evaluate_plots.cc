@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "sapmvs/evaluate/evaluate.h"
+#include "sapmvs/io/raster_io.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
@@ -50,10 +51,9 @@ double NiceCeil(double v) {
   return 10 * p;
 }
 
-// " (m)" for axis labels; the local frame's units when the inputs had no CRS.
+// " (m)" for axis labels.
 std::string Unit(const EvaluationReport& r, bool vertical) {
-  if (r.unit.empty()) return " (local frame units)";
-  return " (" + (vertical && r.unit == "deg" ? std::string("m") : r.unit) + ")";
+  return " (" + (vertical ? HeightLabel(r.unit) : LengthLabel(r.unit)) + ")";
 }
 
 // Block sums of `m` (CV_64F), f x f pixels each: INTER_AREA over whole blocks
@@ -265,9 +265,8 @@ cv::Mat ErrorMap(const EvaluationReport& r, double range) {
   }
   Text(&img, "dz" + Unit(r, true), x0 - 10, kMarginTop - 10);
   Text(&img,
-       "mean dz per " + FormatPrintf("%.3g", dz.f / frame.scale) + " " +
-           (r.unit.empty() ? "local frame units" : r.unit) + " cell, clipped to +-" +
-           FormatPrintf("%g", range),
+       "mean dz per " + FormatPrintf("%.3g", dz.f / frame.scale) + " " + LengthLabel(r.unit) +
+           " cell, clipped to +-" + FormatPrintf("%g", range),
        kMarginLeft, 22, 0.55);
   Text(&img, "dark grey: no reference height", kMarginLeft, 44);
   return img;

@@ -9,6 +9,7 @@
 #include <ostream>
 
 #include "sapmvs/evaluate/evaluate.h"
+#include "sapmvs/io/raster_io.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
@@ -45,11 +46,7 @@ void PrintEvaluationTable(const EvaluationReport& r, std::ostream& out) {
         << r.dsm_height << " cells of " << FmtOrDash("%.4g", r.dsm_cell_size) << ", "
         << r.reference_points << " non-empty; heights bilinear between cell centres\n";
   }
-  // Vertical: metres also for a geographic CRS.
-  const std::string unit = r.unit.empty()    ? "local frame units"
-                           : r.unit == "deg" ? std::string("m")
-                                             : r.unit;
-  out << "tolerance     " << FmtOrDash("%g", r.tolerance) << " (" << unit << ")\n";
+  out << "tolerance     " << FmtOrDash("%g", r.tolerance) << " (" << HeightLabel(r.unit) << ")\n";
   out << "no reference  " << r.without_reference << " of " << r.cloud_points << " points ("
       << Percent(r.without_reference, r.cloud_points) << ") "
       << (lidar ? "have no LiDAR point within d" : "lie outside the DSM or next to empty cells")

@@ -167,7 +167,7 @@ void Text(cv::Mat* img, const std::string& text, int x, int y, double scale = 0.
 // bar from `lo` (bottom) to `hi` (top) with ticks, and the scale bar.
 void DrawLegend(cv::Mat* img, int x0, double lo, double hi, double pixel_size,
                 const std::string& unit) {
-  const std::string height_unit = unit.empty() ? "local frame units" : unit == "deg" ? "m" : unit;
+  const std::string height_unit = HeightLabel(unit);
   const int left = x0 + 20, top = 44;
   const int bar_h = std::min(400, img->rows - top - 150), bar_w = 22;
   Text(img, "height (" + height_unit + ")", left, 26, 0.5);
@@ -192,8 +192,7 @@ void DrawLegend(cv::Mat* img, int x0, double lo, double hi, double pixel_size,
     y += 40;
     cv::rectangle(*img, {left, y - 6}, {left + px / 2, y}, cv::Scalar(0, 0, 0), cv::FILLED);
     cv::rectangle(*img, {left, y - 6}, {left + px, y}, cv::Scalar(0, 0, 0));
-    Text(img, FormatNumber(length, 6) + " " + (unit.empty() ? "local frame units" : unit), left,
-         y + 20);
+    Text(img, FormatNumber(length, 6) + " " + LengthLabel(unit), left, y + 20);
   }
   Text(img, "north up", left, y + 44);
 }

@@ -117,5 +117,13 @@ WktFacts ReadWktFacts(const std::string& wkt);
 // geographic CRS, another unit's name; "" without a CRS or for one that
 // cannot be read.
 std::string CrsLinearUnit(const std::string& crs);
+// How a length in CrsLinearUnit's `unit` is labelled: the unit, or "local
+// frame units" without a CRS; a height also in metres for a geographic CRS.
+inline std::string LengthLabel(const std::string& unit) {
+  return unit.empty() ? "local frame units" : unit;
+}
+inline std::string HeightLabel(const std::string& unit) {
+  return unit == "deg" ? "m" : LengthLabel(unit);
+}
 
 }  // namespace sapmvs
