@@ -57,6 +57,14 @@ bool LooksEcef(const Block& block) {
   return view.normalized().dot(-centre.normalized()) > 0.5;
 }
 
+GeoReference AsGeoReference(const Eigen::Vector3d& lat_lon_height) {
+  GeoReference g;
+  g.latitude = lat_lon_height.x();
+  g.longitude = lat_lon_height.y();
+  g.altitude = lat_lon_height.z();
+  return g;
+}
+
 void ApplyFrame(const BlockReadOptions& options, Block* block) {
   const std::string where = block->source.string() + ": ";
   if (!options.crs.empty()) {
@@ -82,11 +90,9 @@ void ApplyFrame(const BlockReadOptions& options, Block* block) {
     return;
   }
   if (options.enu_origin) {
-    GeoReference g;
-    g.latitude = options.enu_origin->x();
-    g.longitude = options.enu_origin->y();
-    g.altitude = options.enu_origin->z();
-    if (const std::string p = g.Problem(); !p.empty()) throw Error("--enu-origin: expected " + p);
+    // Checked with the options (BlockReadOptions::Problem); TopocentricToUtm
+    // refuses a bad point too.
+    const GeoReference g = AsGeoReference(*options.enu_origin);
     const TopocentricToUtmReport moved = MoveTopocentricToUtm(g, block);
     block->frame_note = MovedNote("ENU", g, moved);
     return;

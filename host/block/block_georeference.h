@@ -19,6 +19,9 @@ namespace sapmvs {
 // northing of 6.3e6 m) has such centres too, but looks along its own -Z.
 bool LooksEcef(const Block& block);
 
+// BlockReadOptions::enu_origin (latitude, longitude, height) as a point.
+GeoReference AsGeoReference(const Eigen::Vector3d& lat_lon_height);
+
 // Applies options.crs and options.enu_origin to `block`, or moves a block
 // that LooksEcef to UTM; sets block->crs and block->frame_note. Throws Error
 // naming the block when an option contradicts the block's own CRS.

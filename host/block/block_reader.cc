@@ -77,11 +77,8 @@ std::string BlockReadOptions::Problem() const {
     return s.str();
   }
   if (enu_origin) {
-    GeoReference g;
-    g.latitude = enu_origin->x();
-    g.longitude = enu_origin->y();
-    g.altitude = enu_origin->z();
-    if (const std::string p = g.Problem(); !p.empty()) return "an ENU origin with " + p;
+    const std::string p = AsGeoReference(*enu_origin).Problem();
+    if (!p.empty()) return "an ENU origin with " + p;
   }
   return "";
 }
