@@ -42,6 +42,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -307,6 +308,19 @@ std::string Table(const std::vector<Row>& rows, bool with_truth) {
   return t.str();
 }
 
+// Whether `sapmvs run --help` lists `flag`: binaries of earlier commits,
+// compared in the same run, may not have it.
+bool TakesFlag(const fs::path& sapmvs, const std::string& flag) {
+  const std::string command = "'" + sapmvs.string() + "' run --help 2>/dev/null";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return false;
+  std::string text;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) text.append(buffer, n);
+  pclose(pipe);
+  return text.find(flag) != std::string::npos;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -436,6 +450,9 @@ int main(int argc, char** argv) {
                       "--mode", mode, "--restart", "-q"},
                      {{"POCL_CPU_MAX_CU_NUM", std::to_string(threads)}},
                      logs / ("run_" + mode + ".log")};
+      // PMVS2 writes a cloud only: the orthophoto, which a binary before it
+      // does not know to leave out, is not part of the comparison.
+      if (TakesFlag(sapmvs, "--no-ortho")) c.argv.push_back("--no-ortho");
       std::istringstream extra(run_flags);
       for (std::string flag; extra >> flag;) c.argv.push_back(flag);
       if (!run_flags.empty()) r.name += " " + run_flags;

@@ -1,6 +1,7 @@
 // What `sapmvs run` writes, read back by the tools users open it with:
 // cloud.las by @loaders.gl/las and copc.js (node, from npm) and by our own
-// reader, in both LAS versions; the DSM's pictures by GDAL and OpenCV. One run
+// reader, in both LAS versions; the DSM's pictures and the orthophoto by GDAL
+// and OpenCV. One run
 // per LAS version for the whole suite (test::SharedRun; the LAS 1.2 one is
 // also CliRunTest's).
 #include <gdal_priv.h>
@@ -16,6 +17,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_test_util.h"
 #include "sapmvs/io/las_io.h"
@@ -199,6 +201,55 @@ TEST_F(CliRunOutputsTest, DsmPicturesShareTheDsmsGeoreference) {
   EXPECT_GE(std::min(map_w, map_h), 600) << "the small demo DSM is enlarged";
   EXPECT_GT(png.cols, map_w + 100) << "the legend lies right of the map";
   EXPECT_GE(png.rows, map_h);
+}
+
+// ortho.tif is a Cloud-Optimized GeoTIFF over the DSM's ground, in its CRS,
+// RGB with alpha, mostly filled on the simulated block; the PNG and its world
+// file show it whole.
+TEST_F(CliRunOutputsTest, OrthoIsACogOnTheDsmsGround) {
+  const fs::path out = Out("1.2");
+  GDALAllRegister();
+  std::unique_ptr<GDALDataset> dsm(GDALDataset::Open((out / "dsm.tif").c_str(), GDAL_OF_RASTER));
+  std::unique_ptr<GDALDataset> ortho(
+      GDALDataset::Open((out / "ortho.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(dsm && ortho);
+  for (GDALDataset* ds : {dsm.get(), ortho.get()}) {
+    const char* layout = ds->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE");
+    EXPECT_STREQ(layout ? layout : "", "COG") << ds->GetDescription();
+  }
+  ASSERT_EQ(ortho->GetRasterCount(), 4);
+  EXPECT_EQ(ortho->GetRasterBand(4)->GetColorInterpretation(), GCI_AlphaBand);
+  ASSERT_TRUE(dsm->GetSpatialRef() && ortho->GetSpatialRef());
+  EXPECT_TRUE(ortho->GetSpatialRef()->IsSame(dsm->GetSpatialRef()));
+  double a[6], b[6];
+  ASSERT_EQ(dsm->GetGeoTransform(a), CE_None);
+  ASSERT_EQ(ortho->GetGeoTransform(b), CE_None);
+  EXPECT_EQ(a[0], b[0]);
+  EXPECT_EQ(a[3], b[3]);
+  EXPECT_LT(b[1], a[1]) << "the ortho's cells are finer than the DSM's";
+  EXPECT_NEAR(ortho->GetRasterXSize() * b[1], dsm->GetRasterXSize() * a[1], b[1]);
+  const int w = ortho->GetRasterXSize(), h = ortho->GetRasterYSize();
+  std::vector<uint8_t> alpha(static_cast<size_t>(w) * h);
+  ASSERT_EQ(
+      ortho->GetRasterBand(4)->RasterIO(GF_Read, 0, 0, w, h, alpha.data(), w, h, GDT_Byte, 0, 0),
+      CE_None);
+  size_t filled = 0;
+  for (const uint8_t v : alpha) filled += v == 255;
+  // The DSM of the demo block covers about four fifths of its extent.
+  EXPECT_GT(static_cast<double>(filled) / alpha.size(), 0.5);
+  const nlohmann::json report = nlohmann::json::parse(test::Slurp(out / "report.json"));
+  EXPECT_NEAR(report.at("ortho").at("filled_share").get<double>(),
+              static_cast<double>(filled) / alpha.size(), 1e-9);
+  EXPECT_DOUBLE_EQ(report.at("ortho").at("cell").get<double>(), b[1]);
+
+  const cv::Mat png = cv::imread((out / "ortho.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(png.channels(), 4);
+  std::ifstream in(out / "ortho.pgw");
+  std::vector<double> world;
+  for (double x; in >> x;) world.push_back(x);
+  ASSERT_EQ(world.size(), 6u);
+  EXPECT_NEAR(png.cols * world[0], w * b[1], world[0]);
+  EXPECT_DOUBLE_EQ(world[4], b[0] + world[0] / 2);
 }
 
 }  // namespace

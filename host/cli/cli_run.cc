@@ -41,7 +41,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   CLI::App* cmd = app.add_subcommand(
       "run",
       "Dense matching of a block: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png, "
-      "report.json");
+      "ortho.tif, ortho.png, report.json");
   cmd->option_defaults()->group("Input");
   cmd->add_option("block", o->block,
                   "Block: block.yaml, or a PMVS / COLMAP / Strecha / OpenSfM folder")
@@ -56,6 +56,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
   AddOptionFlags(cmd, &o->grouping);
   AddOptionFlags(cmd, o.get(), {{}, {"device"}});
   AddOptionFlags(cmd, &o->dsm);
+  AddOptionFlags(cmd, &o->ortho);
   CLI::Option* profile_option =
       cmd->add_option("--profile", *profile,
                       "Profile the kernels and phases: print tables, write FILE (CSV) and its "
@@ -76,7 +77,7 @@ void RegisterRunCommand(CLI::App& app, const GlobalFlags& global) {
       "                                                   takes the machine's cores divided\n"
       "                                                   by its ranks unless --threads N\n"
       "Outputs in DIR: cloud.ply, cloud.las, dsm.tif, dsm_color.tif, dsm.png (+ .pgw),\n"
-      "report.json, groups/.");
+      "ortho.tif, ortho.png (+ .pgw), report.json, groups/.");
   cmd->callback([o, block_flags, profile, profile_option, &global] {
     o->read = ReadOptionsOf(*block_flags);
     o->profile = profile_option->count() > 0;

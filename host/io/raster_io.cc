@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
@@ -44,60 +45,81 @@ void CheckRaster(const std::filesystem::path& path, const GeoRaster& r) {
   }
 }
 
-void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& raster,
-               const OGRSpatialReference* srs) {
-  GDALDriver* driver = GdalDriver("GTiff");
-  if (!driver) throw Error(file + ": GDAL has no GTiff driver");
-  QuietGdalErrors quiet;
-  CPLStringList options;
-  options.SetNameValue("COMPRESS", "DEFLATE");
-  options.SetNameValue("PREDICTOR", "3");  // floating point: deflate then compresses ~2x better
-  options.SetNameValue("TILED", "YES");
-  options.SetNameValue("BIGTIFF", "IF_SAFER");
-  DatasetPtr ds(driver->Create(tmp.string().c_str(), raster.width, raster.height, 1, GDT_Float32,
-                               options.List()));
-  if (!ds) throw Error(file + ": cannot create GeoTIFF" + quiet.Detail());
-  double geo[6] = {raster.origin_x, raster.cell_size, 0, raster.origin_y, 0, -raster.cell_size};
-  GDALRasterBand* band = ds->GetRasterBand(1);
-  if (ds->SetGeoTransform(geo) != CE_None || (srs && ds->SetSpatialRef(srs) != CE_None) ||
-      band->SetNoDataValue(raster.nodata) != CE_None ||
-      band->RasterIO(GF_Write, 0, 0, raster.width, raster.height,
-                     const_cast<float*>(raster.values.data()), raster.width, raster.height,
-                     GDT_Float32, 0, 0) != CE_None) {
+// The raster in memory, then copied by the COG driver: a Cloud-Optimized
+// GeoTIFF, tiled, with overviews, which GIS and web viewers read in parts.
+// The COG driver writes only copies of a whole dataset.
+void WriteCog(const std::string& file, const std::filesystem::path& tmp, GDALDataset* mem,
+              const GeoRaster& grid, const OGRSpatialReference* srs, QuietGdalErrors& quiet) {
+  double geo[6] = {grid.origin_x, grid.cell_size, 0, grid.origin_y, 0, -grid.cell_size};
+  if (mem->SetGeoTransform(geo) != CE_None || (srs && mem->SetSpatialRef(srs) != CE_None)) {
     throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
   }
-  // Compressed tiles and the directory are written on close, where a full
-  // disk shows up.
+  GDALDriver* cog = GdalDriver("COG");
+  if (!GdalDriver("GTiff")) throw Error(file + ": GDAL has no GTiff driver");  // COG's writer
+  if (!cog) throw Error(file + ": GDAL has no COG driver");
+  CPLStringList options;
+  options.SetNameValue("COMPRESS", "DEFLATE");
+  options.SetNameValue("PREDICTOR", "YES");  // floating point or horizontal, as the type wants
+  options.SetNameValue("BLOCKSIZE", "256");
+  options.SetNameValue("BIGTIFF", "IF_SAFER");
+  // Averages keep an overview's heights and colours those of its cells.
+  options.SetNameValue("RESAMPLING", "AVERAGE");
   CPLErrorReset();
+  DatasetPtr ds(
+      cog->CreateCopy(tmp.string().c_str(), mem, FALSE, options.List(), nullptr, nullptr));
+  if (!ds) throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+  // The directory is written on close, where a full disk shows up.
   ds.reset();
   if (QuietGdalErrors::Failed()) throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+}
+
+DatasetPtr MemDataset(const std::string& file, int width, int height, int bands, GDALDataType type,
+                      QuietGdalErrors& quiet) {
+  GDALDriver* driver = GdalDriver("MEM");
+  if (!driver) throw Error(file + ": GDAL has no MEM driver");
+  DatasetPtr mem(driver->Create("", width, height, bands, type, nullptr));
+  if (!mem) throw Error(file + ": cannot create GeoTIFF" + quiet.Detail());
+  return mem;
+}
+
+// A MEM band over `data` itself (MEM's DATAPOINTER): the copy for the COG
+// driver would double what a large orthophoto holds.
+void AddBandOver(const std::string& file, GDALDataset* mem, GDALDataType type, const void* data,
+                 int pixel_offset, long line_offset, QuietGdalErrors& quiet) {
+  char pointer[64];
+  std::snprintf(pointer, sizeof pointer, "%p", data);
+  CPLStringList options;
+  options.SetNameValue("DATAPOINTER", pointer);
+  options.SetNameValue("PIXELOFFSET", std::to_string(pixel_offset).c_str());
+  options.SetNameValue("LINEOFFSET", std::to_string(line_offset).c_str());
+  if (mem->AddBand(type, options.List()) != CE_None) {
+    throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+  }
+}
+
+void WriteTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& raster,
+               const OGRSpatialReference* srs) {
+  QuietGdalErrors quiet;
+  DatasetPtr mem = MemDataset(file, raster.width, raster.height, 0, GDT_Float32, quiet);
+  AddBandOver(file, mem.get(), GDT_Float32, raster.values.data(), 4, 4L * raster.width, quiet);
+  if (mem->GetRasterBand(1)->SetNoDataValue(raster.nodata) != CE_None) {
+    throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+  }
+  WriteCog(file, tmp, mem.get(), raster, srs, quiet);
 }
 
 // RGBA, 8 bit, interleaved per pixel, on `grid`'s geotransform: photometric
 // RGB with an alpha band, so GIS shows nodata as transparent.
 void WriteRgbaTiff(const std::string& file, const std::filesystem::path& tmp, const GeoRaster& grid,
                    const OGRSpatialReference* srs, const std::vector<uint8_t>& rgba) {
-  GDALDriver* driver = GdalDriver("GTiff");
-  if (!driver) throw Error(file + ": GDAL has no GTiff driver");
   QuietGdalErrors quiet;
-  CPLStringList options;
-  options.SetNameValue("COMPRESS", "DEFLATE");
-  options.SetNameValue("PHOTOMETRIC", "RGB");
-  options.SetNameValue("ALPHA", "YES");
-  options.SetNameValue("TILED", "YES");
-  DatasetPtr ds(
-      driver->Create(tmp.string().c_str(), grid.width, grid.height, 4, GDT_Byte, options.List()));
-  if (!ds) throw Error(file + ": cannot create GeoTIFF" + quiet.Detail());
-  double geo[6] = {grid.origin_x, grid.cell_size, 0, grid.origin_y, 0, -grid.cell_size};
-  if (ds->SetGeoTransform(geo) != CE_None || (srs && ds->SetSpatialRef(srs) != CE_None) ||
-      ds->RasterIO(GF_Write, 0, 0, grid.width, grid.height, const_cast<uint8_t*>(rgba.data()),
-                   grid.width, grid.height, GDT_Byte, 4, nullptr, 4, 4 * grid.width,
-                   1) != CE_None) {
-    throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+  DatasetPtr mem = MemDataset(file, grid.width, grid.height, 0, GDT_Byte, quiet);
+  const GDALColorInterp interp[4] = {GCI_RedBand, GCI_GreenBand, GCI_BlueBand, GCI_AlphaBand};
+  for (int b = 0; b < 4; ++b) {
+    AddBandOver(file, mem.get(), GDT_Byte, rgba.data() + b, 4, 4L * grid.width, quiet);
+    mem->GetRasterBand(b + 1)->SetColorInterpretation(interp[b]);
   }
-  CPLErrorReset();
-  ds.reset();
-  if (QuietGdalErrors::Failed()) throw Error(file + ": cannot write GeoTIFF" + quiet.Detail());
+  WriteCog(file, tmp, mem.get(), grid, srs, quiet);
 }
 
 OGRSpatialReference SpatialRefOf(const std::filesystem::path& path, const std::string& crs) {

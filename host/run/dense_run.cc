@@ -18,6 +18,7 @@
 #include "run/group_dispatch.h"
 #include "run/merged_outputs.h"
 #include "run/mpi_session.h"
+#include "run/ortho_outputs.h"
 #include "run/run_checkpoint.h"
 #include "run/run_report.h"
 #include "sapmvs/block/block_geometry.h"
@@ -26,6 +27,7 @@
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/io/raster_io.h"
 #include "sapmvs/match/match_group.h"
+#include "sapmvs/ortho/true_ortho.h"
 #include "sapmvs/plan/grouping.h"
 #include "sapmvs/run/cloud_dsm.h"
 #include "sapmvs/run/cloud_las.h"
@@ -274,7 +276,24 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   job.crs = block.crs;
   job.out = options.out;
   job.block = options.block;
-  WriteMergedOutputs(job, &report, end_stage);
+  const GeoRaster dsm = WriteMergedOutputs(job, &report, end_stage);
+  if (!options.ortho.skip) {
+    std::unique_ptr<Progress> bar;  // once the images to draw are known
+    const TrueOrtho ortho = MakeTrueOrtho(
+        block, dsm, options.matcher.level, options.ortho, level_gsd, [&](int done, int total) {
+          if (!bar) bar = std::make_unique<Progress>("orthophoto", total, options.matcher.progress);
+          bar->Advance(1, std::to_string(done) + "/" + std::to_string(total) + " images");
+        });
+    if (bar) bar->Finish();
+    WriteOrthoOutputs(ortho, options.out);
+    report.ortho_cell = ortho.grid.cell_size;
+    report.ortho_width = ortho.grid.width;
+    report.ortho_height = ortho.grid.height;
+    report.ortho_filled_cells = ortho.filled_cells;
+    report.ortho_images = ortho.images_used;
+    report.ortho_objects = ortho.objects;
+    end_stage("ortho");
+  }
   report.finished = true;
   report.total_seconds = Since(start);
   report.peak_rss_bytes = ProcessPeakRssBytes();
@@ -376,7 +395,8 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
   out << "total         " << report.total_seconds << " s, peak memory "
       << report.peak_rss_bytes / (1 << 20) << " MiB\n";
   for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm_color.tif", "dsm.png", "dsm.pgw",
-                        "report.json"}) {
+                        "ortho.tif", "ortho.png", "ortho.pgw", "report.json"}) {
+    if (std::string(f).rfind("ortho", 0) == 0 && report.ortho_cell == 0) continue;
     out << "wrote         " << (report.out / f).string() << "\n";
   }
   out.unsetf(std::ios::floatfield);

@@ -19,6 +19,7 @@
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
+#include "sapmvs/util/world_file.h"
 #include "util/gdal_drivers.h"
 #include "util/image_codec.h"
 
@@ -197,18 +198,6 @@ void DrawLegend(cv::Mat* img, int x0, double lo, double hi, double pixel_size,
   Text(img, "north up", left, y + 44);
 }
 
-void WriteWorldFile(const std::filesystem::path& path, const GeoRaster& dsm, double pixel) {
-  // Pixel size, two rotations, the negative row size, then the centre of the
-  // top-left pixel.
-  std::ostringstream s;
-  s.precision(17);
-  s << pixel << "\n0\n0\n"
-    << -pixel << "\n"
-    << dsm.origin_x + pixel / 2 << "\n"
-    << dsm.origin_y - pixel / 2 << "\n";
-  WriteTextAtomically(path, s.str());
-}
-
 }  // namespace
 
 std::string DsmPictureOptions::Problem() const {
@@ -262,7 +251,7 @@ DsmPictures WriteDsmPictures(const GeoRaster& dsm, const std::filesystem::path& 
   DrawLegend(&img, map.cols, lo, hi, pixel, CrsLinearUnit(dsm.crs));
   const std::vector<uint8_t> bytes = EncodeImage(img, ImageEncoding::kPng, png.string());
   WriteBytesAtomically(png, bytes.data(), bytes.size());
-  WriteWorldFile(out.world_file, dsm, pixel);
+  WriteWorldFile(out.world_file, dsm.origin_x, dsm.origin_y, pixel);
   return out;
 }
 

@@ -19,8 +19,8 @@ constexpr size_t kSpacingSamples = 200000;
 
 }  // namespace
 
-void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
-                        const std::function<void(const std::string&)>& end_stage) {
+GeoRaster WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
+                             const std::function<void(const std::string&)>& end_stage) {
   const std::filesystem::path ply = job.out / "cloud.ply", las = job.out / "cloud.las";
   PointSpill spill(job.out);
   PointCloud format;
@@ -120,6 +120,7 @@ void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
   ply_done.get();
   dsm_done.get();
   end_stage("write");
+  return dsm;
 }
 
 }  // namespace sapmvs

@@ -31,7 +31,8 @@ struct MergedOutputsJob {
 // mean_spacing, dsm_cell, area, density and merge_tiles. Calls `end_stage`
 // with "merge", "statistics" and "write" as each ends. Throws sapmvs::Error
 // naming the block when no point survives; nothing is written then.
-void WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
-                        const std::function<void(const std::string&)>& end_stage);
+// Returns the DSM, for the orthophoto.
+GeoRaster WriteMergedOutputs(const MergedOutputsJob& job, RunReport* report,
+                             const std::function<void(const std::string&)>& end_stage);
 
 }  // namespace sapmvs

@@ -4,6 +4,7 @@
 #include <type_traits>
 
 #include "sapmvs/match/matcher_options.h"
+#include "sapmvs/ortho/ortho_options.h"
 #include "sapmvs/plan/grouping_options.h"
 #include "sapmvs/run/cloud_dsm.h"
 #include "sapmvs/run/run_options.h"
@@ -64,6 +65,8 @@ std::string OptionsReference() {
   Table<RunOptions>(out, "Run (RunOptions)", "include/sapmvs/run/run_options.h",
                     "Taken by `run`, beside BLOCK, --out and --profile [FILE].");
   Table<DsmOptions>(out, "DSM (DsmOptions)", "include/sapmvs/run/cloud_dsm.h", "Taken by `run`.");
+  Table<OrthoOptions>(out, "Orthophoto (OrthoOptions)", "include/sapmvs/ortho/ortho_options.h",
+                      "Taken by `run`.");
   return out.str();
 }
 

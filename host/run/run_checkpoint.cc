@@ -69,7 +69,8 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
   std::error_code ec;
   for (const char* f :
        {"cloud.ply", "cloud.las", "dsm.tif", "dsm.tif.aux.xml", "dsm.png", "dsm.pgw",
-        "dsm_color.tif", "dsm_color.tif.aux.xml", "report.json", "profile.csv", "profile.json"}) {
+        "dsm_color.tif", "dsm_color.tif.aux.xml", "ortho.tif", "ortho.tif.aux.xml", "ortho.png",
+        "ortho.pgw", "report.json", "profile.csv", "profile.json"}) {
     std::filesystem::remove(out / f, ec);
   }
   RemoveCheckpoints(out / "groups");

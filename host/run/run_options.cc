@@ -20,6 +20,7 @@ std::string RunOptions::Problem() const {
   if (std::string p = grouping.Problem(); !p.empty()) return p;
   if (std::string p = FirstRangeProblem(*this); !p.empty()) return p;
   if (std::string p = dsm.Problem(); !p.empty()) return "DSM " + p;
+  if (std::string p = ortho.Problem(); !p.empty()) return "orthophoto " + p;
   return "";
 }
 

@@ -127,6 +127,15 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["density_per_unit2"] = report.density;
   j["covered_area_unit2"] = report.area;
   j["dsm_cell"] = report.dsm_cell;
+  if (report.ortho_cell > 0) {
+    const long cells = static_cast<long>(report.ortho_width) * report.ortho_height;
+    j["ortho"] = {{"cell", report.ortho_cell},
+                  {"width", report.ortho_width},
+                  {"height", report.ortho_height},
+                  {"filled_share", cells > 0 ? double(report.ortho_filled_cells) / cells : 0.0},
+                  {"images", report.ortho_images},
+                  {"objects", report.ortho_objects}};
+  }
   j["peak_rss_bytes"] = report.peak_rss_bytes;
   j["grouping"] = report.strategy;
   j["ungrouped"] = report.ungrouped;

@@ -35,6 +35,7 @@ GDALDriver* GdalDriver(const std::string& name) {
   if (name == "MEM") reg = &GDALRegister_MEM;
   if (name == "PNM") reg = &GDALRegister_PNM;
   if (name == "BMP") reg = &GDALRegister_BMP;
+  if (name == "COG") reg = &GDALRegister_COG;
   if (!reg) throw Error("GdalDriver: no built-in GDAL driver '" + name + "'");
   std::lock_guard<std::mutex> lock(RegistrationMutex());
   reg();

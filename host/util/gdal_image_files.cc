@@ -77,7 +77,7 @@ cv::Mat DecodeImageWithGdal(const std::filesystem::path& path) {
   }
   const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize();
   // OpenCV's order: blue, green, red; grey (with or without alpha) thrice.
-  int bands[3] = {3, 2, 1};
+  int bands[4] = {3, 2, 1, 4};
   if (ds->GetRasterCount() < 3) bands[0] = bands[1] = bands[2] = 1;
   const bool wide = type == GDT_UInt16;
   cv::Mat pixels(h, w, wide ? CV_16UC3 : CV_8UC3);
@@ -92,8 +92,9 @@ cv::Mat DecodeImageWithGdal(const std::filesystem::path& path) {
 
 std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encoding,
                                        const std::string& what, int jpeg_quality) {
-  if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
-    throw Error(what + ": cannot encode image (expected 8-bit BGR or grey pixels)");
+  if (image.empty() ||
+      (image.type() != CV_8UC3 && image.type() != CV_8UC1 && image.type() != CV_8UC4)) {
+    throw Error(what + ": cannot encode image (expected 8-bit BGR, BGRA or grey pixels)");
   }
   GDALDriver* mem = GdalDriver("MEM");
   GDALDriver* driver = GdalDriver(DriverName(encoding));
@@ -103,18 +104,19 @@ std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encod
   QuietGdalErrors quiet;
   const int n = image.channels();
   DatasetPtr src(mem->Create("", image.cols, image.rows, n, GDT_Byte, nullptr));
-  int bands[3] = {3, 2, 1};
+  int bands[4] = {3, 2, 1, 4};
   if (n == 1) bands[0] = 1;
   if (!src || src->RasterIO(GF_Write, 0, 0, image.cols, image.rows, const_cast<uchar*>(image.data),
                             image.cols, image.rows, GDT_Byte, n, bands, n,
                             static_cast<GSpacing>(image.step), 1, nullptr) != CE_None) {
     throw Error(what + ": cannot encode image" + quiet.Detail());
   }
-  if (n == 3) {
+  if (n >= 3) {
     src->GetRasterBand(1)->SetColorInterpretation(GCI_RedBand);
     src->GetRasterBand(2)->SetColorInterpretation(GCI_GreenBand);
     src->GetRasterBand(3)->SetColorInterpretation(GCI_BlueBand);
   }
+  if (n == 4) src->GetRasterBand(4)->SetColorInterpretation(GCI_AlphaBand);
   // Encoded in GDAL's in-memory file system; the name is unique per call so
   // threads encoding at once do not share a file.
   static std::atomic<unsigned long> serial{0};

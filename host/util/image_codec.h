@@ -27,9 +27,9 @@ cv::Mat DecodeImageFile(const std::filesystem::path& path);
 // Width and height from the file's header.
 cv::Size ReadImageFileSize(const std::filesystem::path& path);
 
-// The bytes of `image` (CV_8UC3 in BGR order or CV_8UC1) as a file of the
-// encoding; `jpeg_quality` (1-100) applies to JPEG only. The formats are
-// lossless except JPEG. Throws sapmvs::Error naming `what` on failure.
+// The bytes of `image` (CV_8UC3 in BGR order, CV_8UC4 in BGRA order, PNG
+// and TIFF only, or CV_8UC1) as a file of the encoding; `jpeg_quality` (1-100) applies to JPEG
+// only. The formats are lossless except JPEG. Throws sapmvs::Error naming `what` on failure.
 std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encoding,
                                        const std::string& what, int jpeg_quality = 95);
 

@@ -39,14 +39,15 @@ struct GeoRaster {
   }
 };
 
-// Writes a float32 GeoTIFF (DEFLATE with the floating-point predictor, 256 px
-// tiles) with the geotransform, nodata value and CRS, atomically. Throws
+// Writes a float32 Cloud-Optimized GeoTIFF (DEFLATE with the floating-point
+// predictor, 256 px tiles, averaged overviews) with the geotransform, nodata
+// value and CRS, atomically. Throws
 // sapmvs::Error naming `path` and the value at fault (inconsistent size, bad
 // cell size, unknown CRS) or the GDAL failure; no file is left behind.
 void WriteGeoTiff(const std::filesystem::path& path, const GeoRaster& raster);
 
-// Writes `rgba` (8 bit, 4 per pixel, row-major, row 0 north) as an RGB GeoTIFF
-// with an alpha band on `grid`'s size, geotransform and CRS (its values are
+// Writes `rgba` (8 bit, 4 per pixel, row-major, row 0 north) as an RGB
+// Cloud-Optimized GeoTIFF with an alpha band on `grid`'s size, geotransform and CRS (its values are
 // not used), atomically, as WriteGeoTiff does.
 void WriteColorGeoTiff(const std::filesystem::path& path, const GeoRaster& grid,
                        const std::vector<uint8_t>& rgba);

@@ -8,6 +8,8 @@
 //                    (cloud_las.h) and the block's CRS
 //   DIR/dsm.tif      GeoTIFF DSM (cloud_dsm.h); its pictures (dsm_picture.h):
 //                    DIR/dsm_color.tif (georeferenced), DIR/dsm.png + dsm.pgw
+//   DIR/ortho.tif    the true orthophoto on the DSM (true_ortho.h), and
+//                    DIR/ortho.png + ortho.pgw to look at
 //   DIR/report.json  provenance (version, commit, command line, times,
 //                    machine, device), CRS and bounds, points, groups,
 //                    per-stage times, kernels, the paper's statistics

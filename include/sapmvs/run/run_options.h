@@ -8,6 +8,7 @@
 #include "sapmvs/block/block_reader.h"
 #include "sapmvs/io/las_io.h"
 #include "sapmvs/match/matcher_options.h"
+#include "sapmvs/ortho/ortho_options.h"
 #include "sapmvs/plan/grouping_options.h"
 #include "sapmvs/run/cloud_dsm.h"
 #include "sapmvs/run/cloud_merge.h"
@@ -63,6 +64,7 @@ struct RunOptions {
   // a block with fewer is merged whole (tiled_merge.h). >= 1000.
   int merge_tile_points = 250000;
   DsmOptions dsm;
+  OrthoOptions ortho;
   // cloud.las: LAS 1.2 by default, which every reader opens (las_io.h).
   LasVersion las_version = LasWriteOptions{}.version;
   // Profile the device queue (CL_QUEUE_PROFILING_ENABLE; the reference's

@@ -71,6 +71,14 @@ struct RunReport {
   double density = 0;       // points per CRS unit squared of covered ground
   double area = 0;
   double dsm_cell = 0;
+  // The orthophoto (0 cells when none was made): its cell, CRS units, its
+  // size, the cells an image coloured, the images that did, and the objects
+  // each taken whole from one image.
+  double ortho_cell = 0;
+  int ortho_width = 0, ortho_height = 0;
+  long ortho_filled_cells = 0;
+  int ortho_images = 0;
+  int ortho_objects = 0;
   // The merged cloud's bounding box, world (CRS) coordinates.
   Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero();
   Eigen::Vector3d bounds_max = Eigen::Vector3d::Zero();

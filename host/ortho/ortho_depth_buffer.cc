@@ -1,0 +1,84 @@
+#include "ortho/ortho_depth_buffer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sapmvs {
+
+OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
+                                   const CellWindow& window, double tolerance)
+    : camera_(camera),
+      width_(camera.width()),
+      height_(camera.height()),
+      tolerance_(tolerance),
+      depth_(static_cast<size_t>(width_) * height_, std::numeric_limits<float>::infinity()) {
+  // One row of projected cell centres at a time: (u, v, depth), depth <= 0
+  // for a centre that is empty or behind the camera.
+  const int n = window.col1 - window.col0 + 1;
+  std::vector<Eigen::Vector3d> above(n), below(n);
+  auto project_row = [&](int r, std::vector<Eigen::Vector3d>* out) {
+    for (int i = 0; i < n; ++i) {
+      const int c = window.col0 + i;
+      (*out)[i] = Eigen::Vector3d(0, 0, -1);
+      if (c >= dsm.width || r >= dsm.height || dsm.IsEmpty(c, r)) continue;
+      const Eigen::Vector2d xy = dsm.CellCenter(c, r);
+      const Eigen::Vector3d cam = camera.ToCamera({xy.x(), xy.y(), dsm.at(c, r)});
+      if (!(cam.z() > 0)) continue;
+      const Eigen::Vector3d uvw = camera.intrinsics().K() * cam;
+      (*out)[i] = Eigen::Vector3d(uvw.x() / uvw.z(), uvw.y() / uvw.z(), cam.z());
+    }
+  };
+  const int row1 = std::min(window.row1 + 1, dsm.height);
+  if (window.Empty()) return;
+  project_row(window.row0, &above);
+  for (int r = window.row0 + 1; r < row1; ++r) {
+    project_row(r, &below);
+    for (int i = 0; i + 1 < n; ++i) {
+      const Eigen::Vector3d &a = above[i], &b = above[i + 1], &c = below[i], &d = below[i + 1];
+      if (a.z() > 0 && b.z() > 0 && c.z() > 0) DrawTriangle(a, b, c);
+      if (b.z() > 0 && d.z() > 0 && c.z() > 0) DrawTriangle(b, d, c);
+      // A quad with one empty corner keeps the triangle of the other three.
+      if (a.z() > 0 && b.z() > 0 && d.z() > 0 && !(c.z() > 0)) DrawTriangle(a, b, d);
+      if (a.z() > 0 && d.z() > 0 && c.z() > 0 && !(b.z() > 0)) DrawTriangle(a, d, c);
+    }
+    std::swap(above, below);
+  }
+}
+
+void OrthoDepthBuffer::DrawTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c) {
+  const double x0 = std::max(0.0, std::ceil(std::min({a.x(), b.x(), c.x()})));
+  const double x1 = std::min(width_ - 1.0, std::floor(std::max({a.x(), b.x(), c.x()})));
+  const double y0 = std::max(0.0, std::ceil(std::min({a.y(), b.y(), c.y()})));
+  const double y1 = std::min(height_ - 1.0, std::floor(std::max({a.y(), b.y(), c.y()})));
+  if (x0 > x1 || y0 > y1) return;
+  const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+  if (std::abs(area) < 1e-12) return;
+  // 1/depth is affine over the image of a plane: interpolated, it gives
+  // the plane's depth at each pixel.
+  const double ia = 1 / a.z(), ib = 1 / b.z(), ic = 1 / c.z();
+  for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y) {
+    for (int x = static_cast<int>(x0); x <= static_cast<int>(x1); ++x) {
+      const double wb = ((x - a.x()) * (c.y() - a.y()) - (y - a.y()) * (c.x() - a.x())) / area;
+      const double wc = ((b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x())) / area;
+      const double wa = 1 - wb - wc;
+      if (wa < -1e-9 || wb < -1e-9 || wc < -1e-9) continue;
+      const float z = static_cast<float>(1 / (wa * ia + wb * ib + wc * ic));
+      float& d = depth_[static_cast<size_t>(y) * width_ + x];
+      d = std::min(d, z);
+    }
+  }
+}
+
+bool OrthoDepthBuffer::Sees(const Eigen::Vector3d& x, Eigen::Vector2d* uv) const {
+  const Eigen::Vector3d cam = camera_.ToCamera(x);
+  if (!(cam.z() > 0)) return false;
+  const Intrinsics& k = camera_.intrinsics();
+  *uv = {k.fx * cam.x() / cam.z() + k.cx, k.fy * cam.y() / cam.z() + k.cy};
+  const long px = std::lround(uv->x()), py = std::lround(uv->y());
+  if (px < 0 || py < 0 || px >= width_ || py >= height_) return false;
+  return cam.z() <= depth_[static_cast<size_t>(py) * width_ + px] + tolerance_;
+}
+
+}  // namespace sapmvs

@@ -1,0 +1,58 @@
+#pragma once
+// The DSM as the orthophoto uses it: a height for every ortho cell, the
+// objects (buildings, trees) that must each come from one image, and the
+// part of the grid an image can see.
+#include <Eigen/Core>
+#include <vector>
+
+#include "sapmvs/block/camera.h"
+#include "sapmvs/io/raster_io.h"
+
+namespace sapmvs {
+
+// A rectangle of cells, [col0, col1) x [row0, row1).
+struct CellWindow {
+  int col0 = 0, row0 = 0, col1 = 0, row1 = 0;
+  bool Empty() const { return col1 <= col0 || row1 <= row0; }
+};
+
+struct OrthoSurface {
+  // The DSM with its holes filled (FillEnclosedHoles).
+  GeoRaster dsm;
+  // The ortho's cells; values are the heights, NaN where the DSM has none.
+  GeoRaster grid;
+  // Per DSM cell: the object it belongs to, -1 for open ground.
+  std::vector<int> dsm_object;
+  int objects = 0;
+  // The DSM cell under each ortho column and row.
+  std::vector<int> dsm_col, dsm_row;
+  double zmin = 0, zmax = 0;  // the DSM's height range
+
+  int ObjectAt(int col, int row) const {
+    return dsm_object[static_cast<size_t>(dsm_row[row]) * dsm.width + dsm_col[col]];
+  }
+};
+
+// Fills each hole of `dsm` that the valid cells enclose with a low height
+// of its rim (the 10th percentile): such holes are mostly ground that few
+// images see, beside walls and under trees, or water, which matches no
+// texture; the ortho still needs a surface there to take colours from, and
+// visibility then picks the images that see it. Returns the cells filled.
+long FillEnclosedHoles(GeoRaster* dsm);
+
+// `dsm` with its enclosed holes filled (FillEnclosedHoles), then heights
+// interpolated bilinearly between the centres of the DSM's valid
+// cells (where some of the four are empty, from those that are not). A DSM
+// cell is steep when its height differs from a 4-neighbour's by more than
+// `object_slope` times the cell side; the steep cells grown by `margin`
+// (CRS units) and joined 8-connected are the objects. Throws sapmvs::Error
+// for an ortho over 2^28 cells.
+OrthoSurface MakeOrthoSurface(const GeoRaster& dsm, double cell, double object_slope,
+                              double margin);
+
+// The cells of `grid` that `camera` can see: its image corners' rays met with
+// the planes at heights `zmin` and `zmax`; the whole grid where a corner's
+// ray does not come down to them (an oblique view of the horizon).
+CellWindow ImageWindow(const Camera& camera, const GeoRaster& grid, double zmin, double zmax);
+
+}  // namespace sapmvs
