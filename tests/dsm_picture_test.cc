@@ -176,6 +176,27 @@ TEST_F(DsmPictureTest, PngIsEnlargedWithAWorldFileForTheMapAndALegend) {
   EXPECT_GT(black, 200);
 }
 
+// Without a CRS the legend says "height (local frame units)": the margin
+// widens so that the whole title fits, with white beyond it.
+TEST_F(DsmPictureTest, TheLegendFitsItsLongestLabel) {
+  for (const std::string crs : {"EPSG:32632", ""}) {
+    GeoRaster dsm = SlopeDsm(127, 51);
+    dsm.crs = crs;
+    const DsmPictures p = WriteDsmPictures(dsm, dir_ / "dsm_color.tif", dir_ / "dsm.png");
+    const cv::Mat png = cv::imread(p.png.string(), cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(png.empty());
+    // The title's rows, right of the map: the last dark pixel of its text.
+    int last_dark = 0;
+    for (int y = 8; y < 32; ++y) {
+      for (int x = 127 * 12; x < png.cols; ++x) {
+        if (png.at<uint8_t>(y, x) < 128) last_dark = std::max(last_dark, x);
+      }
+    }
+    EXPECT_GT(last_dark, 127 * 12 + 100) << "'" << crs << "': a title";
+    EXPECT_LT(last_dark, png.cols - 8) << "'" << crs << "': the title is cut";
+  }
+}
+
 TEST_F(DsmPictureTest, ALargeDsmIsNotEnlargedAndAnEmptyOneWritesNothing) {
   const GeoRaster dsm = SlopeDsm(700, 650);
   const DsmPictures p = WriteDsmPictures(dsm, dir_ / "c.tif", dir_ / "d.png");

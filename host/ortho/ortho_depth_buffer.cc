@@ -48,25 +48,32 @@ OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
 
 void OrthoDepthBuffer::DrawTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                     const Eigen::Vector3d& c) {
-  const double x0 = std::max(0.0, std::ceil(std::min({a.x(), b.x(), c.x()})));
-  const double x1 = std::min(width_ - 1.0, std::floor(std::max({a.x(), b.x(), c.x()})));
-  const double y0 = std::max(0.0, std::ceil(std::min({a.y(), b.y(), c.y()})));
-  const double y1 = std::min(height_ - 1.0, std::floor(std::max({a.y(), b.y(), c.y()})));
+  const int x0 = std::max(0, static_cast<int>(std::ceil(std::min({a.x(), b.x(), c.x()}))));
+  const int x1 =
+      std::min(width_ - 1, static_cast<int>(std::floor(std::max({a.x(), b.x(), c.x()}))));
+  const int y0 = std::max(0, static_cast<int>(std::ceil(std::min({a.y(), b.y(), c.y()}))));
+  const int y1 =
+      std::min(height_ - 1, static_cast<int>(std::floor(std::max({a.y(), b.y(), c.y()}))));
   if (x0 > x1 || y0 > y1) return;
   const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
   if (std::abs(area) < 1e-12) return;
-  // 1/depth is affine over the image of a plane: interpolated, it gives
-  // the plane's depth at each pixel.
-  const double ia = 1 / a.z(), ib = 1 / b.z(), ic = 1 / c.z();
-  for (int y = static_cast<int>(y0); y <= static_cast<int>(y1); ++y) {
-    for (int x = static_cast<int>(x0); x <= static_cast<int>(x1); ++x) {
-      const double wb = ((x - a.x()) * (c.y() - a.y()) - (y - a.y()) * (c.x() - a.x())) / area;
-      const double wc = ((b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x())) / area;
-      const double wa = 1 - wb - wc;
-      if (wa < -1e-9 || wb < -1e-9 || wc < -1e-9) continue;
-      const float z = static_cast<float>(1 / (wa * ia + wb * ib + wc * ic));
-      float& d = depth_[static_cast<size_t>(y) * width_ + x];
-      d = std::min(d, z);
+  // The barycentric weights of b and c are affine in the pixel: their
+  // steps along x and y, from their values at (x0, y0). 1/depth is affine
+  // over the image of a plane too: interpolated, it gives the plane's depth.
+  const double inv = 1 / area;
+  const double bx = (c.y() - a.y()) * inv, by = -(c.x() - a.x()) * inv;
+  const double cx = -(b.y() - a.y()) * inv, cy = (b.x() - a.x()) * inv;
+  const double ia = 1 / a.z(), ib = 1 / b.z() - ia, ic = 1 / c.z() - ia;
+  const double wb0 = (x0 - a.x()) * bx + (y0 - a.y()) * by;
+  const double wc0 = (x0 - a.x()) * cx + (y0 - a.y()) * cy;
+  constexpr double kEdge = -1e-9;
+  for (int y = y0; y <= y1; ++y) {
+    double wb = wb0 + (y - y0) * by, wc = wc0 + (y - y0) * cy;
+    float* row = &depth_[static_cast<size_t>(y) * width_];
+    for (int x = x0; x <= x1; ++x, wb += bx, wc += cx) {
+      if (wb < kEdge || wc < kEdge || wb + wc > 1 - kEdge) continue;
+      const float z = static_cast<float>(1 / (ia + wb * ib + wc * ic));
+      row[x] = std::min(row[x], z);
     }
   }
 }

@@ -164,6 +164,19 @@ void Text(cv::Mat* img, const std::string& text, int x, int y, double scale = 0.
               cv::LINE_AA);
 }
 
+// The margin the legend needs: its longest line, "height (local frame
+// units)" or the scale bar's label, and room around it.
+int LegendWidth(const std::string& unit) {
+  int baseline = 0;
+  const int title = cv::getTextSize("height (" + HeightLabel(unit) + ")", cv::FONT_HERSHEY_SIMPLEX,
+                                    0.5, 1, &baseline)
+                        .width;
+  const int scale =
+      cv::getTextSize("1000 " + LengthLabel(unit), cv::FONT_HERSHEY_SIMPLEX, 0.45, 1, &baseline)
+          .width;
+  return std::max(kLegendWidth, 20 + std::max(title, scale) + 12);
+}
+
 // The legend in the margin right of the map (x0 = the map's width): colour
 // bar from `lo` (bottom) to `hi` (top) with ticks, and the scale bar.
 void DrawLegend(cv::Mat* img, int x0, double lo, double hi, double pixel_size,
@@ -244,11 +257,12 @@ DsmPictures WriteDsmPictures(const GeoRaster& dsm, const std::filesystem::path& 
   }
   cv::Mat map;
   cv::resize(cells, map, {}, k, k, cv::INTER_NEAREST);
-  cv::Mat img(std::max(map.rows, kLegendMinHeight), map.cols + kLegendWidth, CV_8UC3,
+  const std::string unit = CrsLinearUnit(dsm.crs);
+  cv::Mat img(std::max(map.rows, kLegendMinHeight), map.cols + LegendWidth(unit), CV_8UC3,
               cv::Scalar(255, 255, 255));
   map.copyTo(img(cv::Rect(0, 0, map.cols, map.rows)));
   const double pixel = dsm.cell_size / k;
-  DrawLegend(&img, map.cols, lo, hi, pixel, CrsLinearUnit(dsm.crs));
+  DrawLegend(&img, map.cols, lo, hi, pixel, unit);
   const std::vector<uint8_t> bytes = EncodeImage(img, ImageEncoding::kPng, png.string());
   WriteBytesAtomically(png, bytes.data(), bytes.size());
   WriteWorldFile(out.world_file, dsm.origin_x, dsm.origin_y, pixel);
