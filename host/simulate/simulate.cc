@@ -14,6 +14,7 @@
 #include "sapmvs/util/output_folder.h"
 #include "sapmvs/util/progress.h"
 #include "simulate/sim_lidar.h"
+#include "simulate/sim_ortho.h"
 #include "simulate/sim_presets.h"
 #include "util/image_codec.h"
 
@@ -285,6 +286,12 @@ SimulateSummary Simulate(const SimulateOptions& o) {
     for (int col = 0; col < dsm.width; ++col)
       classes.at(col, row) = sim::LasClass(scene.CellClass(col, dsm.height - 1 - row));
   WriteGeoTiff(o.out / "truth" / "classes.tif", classes);
+  // The true orthophoto, at the images' nominal GSD over the DSM's extent.
+  sim::TrueOrtho ortho = sim::RenderTrueOrtho(scene, flight.gsd, o.supersampling);
+  ortho.grid.origin_x += offset.x();
+  ortho.grid.origin_y += offset.y();
+  ortho.grid.crs = kCrs;
+  WriteColorGeoTiff(o.out / "truth" / "ortho.tif", ortho.grid, ortho.rgba);
 
   sim::LidarSpec lidar;
   lidar.density = sim::LidarDensityForGsd(flight.gsd);
@@ -327,6 +334,10 @@ SimulateSummary Simulate(const SimulateOptions& o) {
          << " m cells (flat-topped: walls are vertical).\n"
          << "- `truth/classes.tif`: the LAS class of each DSM cell (2 ground, 5 vegetation, "
             "6 building, 9 water).\n"
+         << "- `truth/ortho.tif`: the true orthophoto (RGBA, alpha 0 outside the scene), "
+         << Fixed(flight.gsd, 4) << " m cells from the DSM's north-west corner: the cell tops "
+         << "as seen straight down, " << o.supersampling << "x" << o.supersampling
+         << " points per cell, recorded with gain 1 and the images' tone curve, no noise.\n"
          << "- `truth/lidar.las`" << (o.xyz ? " and `truth/lidar.xyz`" : "") << ": "
          << points.size() << " simulated first returns, " << Fixed(lidar.density, 2)
          << " points/m^2 per strip, "
