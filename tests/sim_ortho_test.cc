@@ -6,13 +6,19 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <random>
 #include <vector>
 
+#include "ortho_truth_metrics.h"
+#include "sapmvs/io/raster_io.h"
 #include "sapmvs/simulate/simulate.h"
 #include "simulate/sim_ortho.h"
+#include "test_util.h"
 
 namespace sapmvs {
 namespace {
+
+namespace fs = std::filesystem;
 
 // The recorded colour of the cell top at local (x, y), as a noise-free
 // image with gain 1 records it.
@@ -82,6 +88,42 @@ TEST(SimOrtho, CellsAreTheRecordedShadeOfTheTopAtTheirCentre) {
   }
   EXPECT_LE(TrueOrthoMedian(at_centre), 6.0);
   EXPECT_GT(TrueOrthoMedian(one_cell_off), TrueOrthoMedian(at_centre));
+}
+
+// The tiny block's truth/ortho.tif on truth/dsm.tif's extent, at the nominal
+// GSD, coloured by the scene BuildWorld rebuilds.
+TEST(SimOrtho, FileOfTheTinyBlock) {
+  const fs::path dir = test::Simulated("tiny", 3);
+  SimulateOptions o = test::SimulatedOptions("tiny", 3);
+  o.out = dir;
+  const SimulatedWorld world = BuildWorld(o);
+  const ColorRaster ortho = ReadColorRaster(dir / "truth" / "ortho.tif");
+  const GeoRaster dsm = ReadGeoRaster(dir / "truth" / "dsm.tif");
+  const GeoRaster& g = ortho.grid;
+  EXPECT_EQ(g.crs, dsm.crs);
+  EXPECT_EQ(g.origin_x, dsm.origin_x);
+  EXPECT_EQ(g.origin_y, dsm.origin_y);
+  EXPECT_NEAR(g.cell_size, world.flight.gsd, 1e-9);
+  const double w = dsm.width * dsm.cell_size, h = dsm.height * dsm.cell_size;
+  EXPECT_GE(g.width * g.cell_size, w - 1e-6);
+  EXPECT_LT(g.width * g.cell_size, w + g.cell_size);
+  EXPECT_GE(g.height * g.cell_size, h - 1e-6);
+  EXPECT_LT(g.height * g.cell_size, h + g.cell_size);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> col(0, g.width - 2), row(0, g.height - 2);
+  std::vector<double> diff;
+  for (int k = 0; k < 4000; ++k) {
+    const int c = col(rng), r = row(rng);
+    ASSERT_TRUE(ortho.Filled(c, r)) << c << " " << r;
+    const Eigen::Vector2d p = g.CellCenter(c, r);
+    const std::array<double, 3> at =
+        RecordedTop(world.scene, p.x() - world.offset.x(), p.y() - world.offset.y());
+    const uint8_t* px = &ortho.rgba[(static_cast<size_t>(r) * g.width + c) * 4];
+    for (int i = 0; i < 3; ++i) diff.push_back(std::abs(px[i] - at[i]));
+  }
+  // 2 x 2 points per cell against one at the centre: close, not equal.
+  EXPECT_LT(TrueOrthoMedian(diff), 3.0);
+  EXPECT_NE(test::Slurp(dir / "truth" / "README.md").find("`truth/ortho.tif`"), std::string::npos);
 }
 
 }  // namespace
