@@ -9,7 +9,7 @@
 // ground (a roof leaning onto the street: what a true ortho must not show).
 // The definitions are in ortho_truth_metrics.h.
 //
-//   ortho_truth ORTHO.tif --truth SIM/truth [--tile 64] [--json FILE]
+//   ortho_truth ORTHO.tif --truth SIM/truth [--dsm RUN/dsm.tif] [--tile 64] [--json FILE]
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "ortho_truth_metrics.h"
 #include "sapmvs/util/error.h"
@@ -47,20 +48,26 @@ nlohmann::json ToJson(const OrthoTruth& r, const std::string& ortho) {
           {"shift_east_gsd", r.shift_east},
           {"shift_north_gsd", r.shift_north},
           {"ghost_high", side(r.high)},
-          {"ghost_low", side(r.low)}};
+          {"ghost_low", side(r.low)},
+          {"ghost_high_dsm_right", side(r.high_right)},
+          {"ghost_low_dsm_right", side(r.low_right)}};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app("An orthophoto against the simulator's true orthophoto");
-  std::string ortho_path, truth_dir, json_path;
+  std::string ortho_path, truth_dir, json_path, dsm_path;
   OrthoTruthOptions options;
   app.add_option("ortho", ortho_path, "Orthophoto, 8-bit RGBA GeoTIFF (alpha 0 = empty)")
       ->required();
   app.add_option("--truth", truth_dir, "The simulated block's truth folder (ortho.tif, dsm.tif)")
       ->required();
   app.add_option("--json", json_path, "Also write the numbers to this JSON file");
+  app.add_option(
+      "--dsm", dsm_path,
+      "The DSM the ortho was made on (a run's dsm.tif): also the wrong sides where it is "
+      "right");
   cli::AddOptionFlags(&app, &options);
   CLI11_PARSE(app, argc, argv);
   try {
@@ -68,9 +75,11 @@ int main(int argc, char** argv) {
     const ColorRaster ortho = ReadColorRaster(ortho_path);
     const ColorRaster truth = ReadColorRaster(truth_path / "ortho.tif");
     const GeoRaster dsm = ReadGeoRaster(truth_path / "dsm.tif");
+    std::optional<GeoRaster> ortho_dsm;
+    if (!dsm_path.empty()) ortho_dsm = ReadGeoRaster(dsm_path);
     const OrthoTruth r = [&] {
       try {
-        return CompareOrthoToTruth(ortho, truth, dsm, options);
+        return CompareOrthoToTruth(ortho, truth, dsm, options, ortho_dsm ? &*ortho_dsm : nullptr);
       } catch (const Error& e) {
         throw Error(ortho_path + ": " + e.what());
       }
@@ -90,6 +99,13 @@ int main(int argc, char** argv) {
               << row << "(|dY|, bias: luminance, 8-bit levels; shift: truth GSDs, of the tiles "
               << "used; wrong side: of " << r.high.cells << " roof and " << r.low.cells
               << " ground edge cells)\n";
+    if (ortho_dsm) {
+      std::printf(
+          "where the DSM is right (within %g GSD): wrong side %.1f%% of %ld roof, %.1f%% of "
+          "%ld ground edge cells\n",
+          options.dsm_tolerance_gsd, 100 * r.high_right.Share(), r.high_right.cells,
+          100 * r.low_right.Share(), r.low_right.cells);
+    }
     if (!json_path.empty()) {
       std::ofstream f(json_path);
       f << ToJson(r, ortho_path).dump(2) << "\n";

@@ -215,7 +215,7 @@ cv::Mat OrthoNearSteps(const GeoRaster& dsm, double step, int radius) {
 // The wrong-side counts of the edge cells (see OrthoTruthOptions).
 void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRaster& dsm,
                 const std::vector<OrthoRgb>& truth_rgb, const std::vector<uint8_t>& both,
-                const OrthoTruthOptions& o, OrthoTruth* out) {
+                const OrthoTruthOptions& o, const GeoRaster* ortho_dsm, OrthoTruth* out) {
   const double step = o.step_gsd * out->gsd, across = o.across_gsd * out->gsd;
   // A step lies on a cell's side, half a cell from its centre.
   const int radius =
@@ -228,7 +228,8 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
     dirs[k] = {std::cos(a), std::sin(a)};
   }
   const GeoRaster& g = ortho.grid;
-  std::vector<std::array<long, 4>> rows(g.height, {0, 0, 0, 0});  // high, wrong, low, wrong
+  // High, wrong, low, wrong; the same where the ortho's DSM is right.
+  std::vector<std::array<long, 8>> rows(g.height, {0, 0, 0, 0, 0, 0, 0, 0});
   ParallelFor(g.height, [&](long row) {
     for (int col = 0; col < g.width; ++col) {
       const size_t i = static_cast<size_t>(row) * g.width + col;
@@ -264,11 +265,18 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
       const int side = sign < 0 ? 0 : 2;  // the other side lower: this is a roof
       ++rows[row][side];
       rows[row][side + 1] += wrong;
+      if (ortho_dsm && std::abs(OrthoDsmHeight(*ortho_dsm, p.x(), p.y()) - h0) <=
+                           o.dsm_tolerance_gsd * out->gsd) {
+        ++rows[row][4 + side];
+        rows[row][4 + side + 1] += wrong;
+      }
     }
   });
   for (const auto& r : rows) {
     out->high.cells += r[0], out->high.wrong += r[1];
     out->low.cells += r[2], out->low.wrong += r[3];
+    out->high_right.cells += r[4], out->high_right.wrong += r[5];
+    out->low_right.cells += r[6], out->low_right.wrong += r[7];
   }
 }
 
@@ -316,7 +324,8 @@ ColorRaster ReadColorRaster(const std::filesystem::path& path) {
 }
 
 OrthoTruth CompareOrthoToTruth(const ColorRaster& ortho, const ColorRaster& truth,
-                               const GeoRaster& dsm, const OrthoTruthOptions& options) {
+                               const GeoRaster& dsm, const OrthoTruthOptions& options,
+                               const GeoRaster* ortho_dsm) {
   if (const std::string problem = options.Problem(); !problem.empty())
     throw Error("expected " + problem);
   if (!OrthoSameCrs(ortho.grid.crs, truth.grid.crs) || !OrthoSameCrs(dsm.crs, truth.grid.crs))
@@ -372,7 +381,7 @@ OrthoTruth CompareOrthoToTruth(const ColorRaster& ortho, const ColorRaster& trut
   out.luminance_p95 = OrthoQuantile(abs_diff, 0.95);
 
   OrthoShifts(ortho, truth_rgb, truth_valid, options, &out);
-  OrthoEdges(ortho, truth, dsm, truth_rgb, both, options, &out);
+  OrthoEdges(ortho, truth, dsm, truth_rgb, both, options, ortho_dsm, &out);
   return out;
 }
 

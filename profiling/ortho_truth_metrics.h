@@ -44,6 +44,10 @@ struct OrthoTruthOptions {
   // Edge cells whose two sides' true colours are closer than this (RGB
   // distance, 8-bit levels) cannot tell sides apart and are not counted.
   double min_contrast = 12;
+  // With the DSM the ortho was draped on: an edge cell where that DSM lies
+  // within this many truth GSDs of the true height is one "where the DSM is
+  // right", whose wrong side is the ortho's own fault.
+  double dsm_tolerance_gsd = 2;
   // Empty when usable, else what was expected, naming the value.
   std::string Problem() const;
 };
@@ -91,6 +95,12 @@ void VisitFields(OrthoTruthOptions& o, F&& f) {
         .Unit("levels")
         .Range(AtLeast(0))
         .Help("Least RGB distance between the two sides' true colours of a counted edge cell"));
+  f(Field(o.dsm_tolerance_gsd, "dsm_tolerance_gsd")
+        .Flag("--dsm-tolerance")
+        .In("Comparison")
+        .Unit("GSD")
+        .Range(Above(0))
+        .Help("With --dsm: an edge cell's DSM is right within this many truth GSDs"));
 }
 
 struct EdgeSide {
@@ -113,6 +123,8 @@ struct OrthoTruth {
   int tiles = 0, tiles_used = 0;
   double shift_median = 0, shift_p95 = 0, shift_east = 0, shift_north = 0;
   EdgeSide high, low;  // roofs and crowns; the ground beside them
+  // The same, of the edge cells where the ortho's DSM is right (with one).
+  EdgeSide high_right, low_right;
   double Coverage() const {
     return truth_cells > 0 ? static_cast<double>(covered_cells) / truth_cells : 0;
   }
@@ -123,7 +135,10 @@ struct OrthoTruth {
 // CRS. Throws sapmvs::Error saying what was expected when the options are
 // out of range, the CRSs differ or the ortho misses the truth (the caller
 // names the ortho's file).
+// `ortho_dsm`, when given, is the DSM the ortho was made on (a run's
+// dsm.tif), for high_right and low_right.
 OrthoTruth CompareOrthoToTruth(const ColorRaster& ortho, const ColorRaster& truth,
-                               const GeoRaster& dsm, const OrthoTruthOptions& options = {});
+                               const GeoRaster& dsm, const OrthoTruthOptions& options = {},
+                               const GeoRaster* ortho_dsm = nullptr);
 
 }  // namespace sapmvs

@@ -126,6 +126,17 @@ TEST(OrthoSurfaceTest, ABoxIsOneObjectAndFlatGroundNone) {
   // The roof's middle, far from its edges, is part of it; open ground not.
   EXPECT_EQ(box.ObjectAt(60, 60), 0);
   EXPECT_EQ(box.ObjectAt(10, 10), -1);
+  // Heights across the box's wall: the nearest cell's, not a slope that
+  // would lean the roof over the ground (cell centres at 24.75 and 25.25 m
+  // east, between the DSM's at 24.5 and 25.5).
+  EXPECT_FLOAT_EQ(box.grid.at(49, 59), 0.f);
+  EXPECT_FLOAT_EQ(box.grid.at(50, 59), static_cast<float>(kBoxTop));
+  // On one surface, bilinear: a ramp of 1 per cell.
+  GeoRaster ramp = FlatDsm(9, 1.0, 0);
+  for (int r = 0; r < 9; ++r) {
+    for (int c = 0; c < 9; ++c) ramp.at(c, r) = static_cast<float>(c) * 0.5f;
+  }
+  EXPECT_FLOAT_EQ(MakeOrthoSurface(ramp, 0.5, 1.0, 1.0).grid.at(6, 4), 1.375f);
 }
 
 TEST(OrthoDepthBufferTest, TheBoxHidesTheGroundBehindIt) {

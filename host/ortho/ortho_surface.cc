@@ -15,24 +15,36 @@ namespace {
 constexpr double kMaxOrthoCells = 268435456.0;  // 2^28, as the DSM
 
 // Bilinear between the centres of the valid cells among the four around
-// (x, y); NaN when none of them is valid.
-float InterpolateHeight(const GeoRaster& dsm, double x, double y) {
+// (x, y), where they lie on one surface; across a step higher than `step`
+// (a roof's edge, a wall), the nearest cell's height: interpolated, a roof
+// would lean half a cell over the ground at its foot and be drawn there
+// again. NaN when none of the four is valid.
+float InterpolateHeight(const GeoRaster& dsm, double x, double y, double step) {
   const double fc = (x - dsm.origin_x) / dsm.cell_size - 0.5;
   const double fr = (dsm.origin_y - y) / dsm.cell_size - 0.5;
   const int c0 = static_cast<int>(std::floor(fc)), r0 = static_cast<int>(std::floor(fr));
   const double tx = fc - c0, ty = fr - r0;
-  double sum = 0, weight = 0;
+  double sum = 0, weight = 0, nearest_w = -1;
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo, nearest = 0;
   for (int dr = 0; dr < 2; ++dr) {
     for (int dc = 0; dc < 2; ++dc) {
       const int c = std::clamp(c0 + dc, 0, dsm.width - 1);
       const int r = std::clamp(r0 + dr, 0, dsm.height - 1);
       if (dsm.IsEmpty(c, r)) continue;
+      const float z = dsm.at(c, r);
       const double w = (dc ? tx : 1 - tx) * (dr ? ty : 1 - ty) + 1e-9;
-      sum += w * dsm.at(c, r);
+      sum += w * z;
       weight += w;
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+      if (w > nearest_w) {
+        nearest_w = w;
+        nearest = z;
+      }
     }
   }
-  return weight > 0 ? static_cast<float>(sum / weight) : std::numeric_limits<float>::quiet_NaN();
+  if (!(weight > 0)) return std::numeric_limits<float>::quiet_NaN();
+  return hi - lo > step ? nearest : static_cast<float>(sum / weight);
 }
 
 void FindObjects(const GeoRaster& dsm, double object_slope, double margin, OrthoSurface* s) {
@@ -152,7 +164,7 @@ OrthoSurface MakeOrthoSurface(const GeoRaster& source, double cell, double objec
   for (int r = 0; r < g.height; ++r) {
     for (int c = 0; c < g.width; ++c) {
       const Eigen::Vector2d p = g.CellCenter(c, r);
-      g.at(c, r) = InterpolateHeight(dsm, p.x(), p.y());
+      g.at(c, r) = InterpolateHeight(dsm, p.x(), p.y(), object_slope * dsm.cell_size);
     }
   }
   s.zmin = std::numeric_limits<double>::infinity();

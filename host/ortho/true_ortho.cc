@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/photo.hpp>
 #include <string>
 
 #include "ortho/ortho_depth_buffer.h"
@@ -26,6 +27,8 @@ constexpr int kObjectMarginCells = 2;
 // ortho's heights interpolate the cells differently from the triangles, and
 // at a roof's edge the triangles slope down to the ground.
 constexpr double kSeenToleranceCells = 1.5;
+// Gaps no image sees are inpainted up to this many cells from a colour.
+constexpr int kGapCells = 4;
 // Images decoded at once for the colours, at most.
 constexpr int kImagesAtOnce = 4;
 
@@ -96,6 +99,41 @@ std::vector<int> ChooseObjectViews(const OrthoSurface& surface,
     }
   }
   return chosen;
+}
+
+// Cells on the DSM that no image sees, within kGapCells of cells that one
+// does: slivers at the foot of walls, where the DSM's step from the ground
+// to the roof spans a cell and hides them from every view. Inpainted from
+// around them (OpenCV's Telea) rather than left as holes along every roof.
+long FillGaps(const GeoRaster& grid, std::vector<uint8_t>* rgba) {
+  cv::Mat filled(grid.height, grid.width, CV_8U), gap(grid.height, grid.width, CV_8U);
+  for (int r = 0; r < grid.height; ++r) {
+    for (int c = 0; c < grid.width; ++c) {
+      const bool colour = (*rgba)[4 * (static_cast<size_t>(r) * grid.width + c) + 3] != 0;
+      filled.at<uint8_t>(r, c) = colour ? 255 : 0;
+      gap.at<uint8_t>(r, c) = !colour && !std::isnan(grid.at(c, r)) ? 255 : 0;
+    }
+  }
+  cv::Mat near;
+  cv::dilate(
+      filled, near,
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kGapCells + 1, 2 * kGapCells + 1)));
+  gap &= near;
+  const long n = cv::countNonZero(gap);
+  if (n == 0) return 0;
+  cv::Mat bgr(grid.height, grid.width, CV_8UC3);
+  cv::Mat bgra(grid.height, grid.width, CV_8UC4, rgba->data());
+  cv::cvtColor(bgra, bgr, cv::COLOR_RGBA2BGR);
+  cv::inpaint(bgr, gap, bgr, kGapCells, cv::INPAINT_TELEA);
+  for (int r = 0; r < grid.height; ++r) {
+    for (int c = 0; c < grid.width; ++c) {
+      if (!gap.at<uint8_t>(r, c)) continue;
+      const cv::Vec3b v = bgr.at<cv::Vec3b>(r, c);
+      uint8_t* q = &(*rgba)[4 * (static_cast<size_t>(r) * grid.width + c)];
+      q[0] = v[2], q[1] = v[1], q[2] = v[0], q[3] = 255;
+    }
+  }
+  return n;
 }
 
 }  // namespace
@@ -264,6 +302,8 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
     ++out.filled_cells;
   }
   sum = {};
+  out.inpainted_cells = FillGaps(grid, &out.rgba);
+  out.filled_cells += out.inpainted_cells;
   out.images_used = static_cast<int>(used_views.size());
   out.objects = surface.objects;
   return out;

@@ -11,8 +11,8 @@
 // Objects (steep DSM cells, ortho_surface.h) are each taken whole from the
 // image that sees the most of them, so that the seams where the chosen image
 // changes run over open ground; across a seam the colours are blended over
-// a few cells. Cells no image sees, and those without a DSM height, stay
-// empty (alpha 0).
+// a few cells. Narrow gaps no image sees are inpainted from around them;
+// wider ones, and cells without a DSM height, stay empty (alpha 0).
 
 #include <cstdint>
 #include <functional>
@@ -30,8 +30,9 @@ struct TrueOrtho {
   // 8-bit RGBA per cell, row-major, row 0 north; alpha 0 = empty.
   std::vector<uint8_t> rgba;
   long filled_cells = 0;
-  int images_used = 0;  // images that coloured at least one cell
-  int objects = 0;      // objects taken whole from one image
+  long inpainted_cells = 0;  // of those, gaps no image sees, filled from around
+  int images_used = 0;       // images that coloured at least one cell
+  int objects = 0;           // objects taken whole from one image
 };
 
 // The ortho of `block` at pyramid `level` over `dsm` (block CRS, world
