@@ -104,34 +104,61 @@ std::vector<int> ChooseObjectViews(const OrthoSurface& surface,
 // Cells on the DSM that no image sees, within kGapCells of cells that one
 // does: slivers at the foot of walls, where the DSM's step from the ground
 // to the roof spans a cell and hides them from every view. Inpainted from
-// around them (OpenCV's Telea) rather than left as holes along every roof.
+// around them (OpenCV's Telea) rather than left as holes along every roof;
+// tile by tile, as Telea's cost and its copies grow with the whole image.
 long FillGaps(const GeoRaster& grid, std::vector<uint8_t>* rgba) {
-  cv::Mat filled(grid.height, grid.width, CV_8U), gap(grid.height, grid.width, CV_8U);
-  for (int r = 0; r < grid.height; ++r) {
-    for (int c = 0; c < grid.width; ++c) {
-      const bool colour = (*rgba)[4 * (static_cast<size_t>(r) * grid.width + c) + 3] != 0;
-      filled.at<uint8_t>(r, c) = colour ? 255 : 0;
-      gap.at<uint8_t>(r, c) = !colour && !std::isnan(grid.at(c, r)) ? 255 : 0;
-    }
+  constexpr int kTile = 256, kMargin = 2 * kGapCells;
+  std::vector<cv::Rect> tiles;
+  for (int y = 0; y < grid.height; y += kTile) {
+    for (int x = 0; x < grid.width; x += kTile)
+      tiles.emplace_back(x, y, std::min(kTile, grid.width - x), std::min(kTile, grid.height - y));
   }
-  cv::Mat near;
-  cv::dilate(
-      filled, near,
-      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kGapCells + 1, 2 * kGapCells + 1)));
-  gap &= near;
-  const long n = cv::countNonZero(gap);
-  if (n == 0) return 0;
-  cv::Mat bgr(grid.height, grid.width, CV_8UC3);
-  cv::Mat bgra(grid.height, grid.width, CV_8UC4, rgba->data());
-  cv::cvtColor(bgra, bgr, cv::COLOR_RGBA2BGR);
-  cv::inpaint(bgr, gap, bgr, kGapCells, cv::INPAINT_TELEA);
-  for (int r = 0; r < grid.height; ++r) {
-    for (int c = 0; c < grid.width; ++c) {
-      if (!gap.at<uint8_t>(r, c)) continue;
-      const cv::Vec3b v = bgr.at<cv::Vec3b>(r, c);
-      uint8_t* q = &(*rgba)[4 * (static_cast<size_t>(r) * grid.width + c)];
+  // Read from the colours as they were, written after: a tile's margin is
+  // its neighbours' cells.
+  std::vector<std::vector<std::pair<size_t, cv::Vec3b>>> fills(tiles.size());
+  ParallelFor(static_cast<long>(tiles.size()), [&](long t) {
+    const cv::Rect tile = tiles[t];
+    const cv::Rect box = (tile + cv::Size(2 * kMargin, 2 * kMargin) - cv::Point(kMargin, kMargin)) &
+                         cv::Rect(0, 0, grid.width, grid.height);
+    cv::Mat bgr(box.size(), CV_8UC3), has(box.size(), CV_8U), gap(box.size(), CV_8U);
+    bool any = false;
+    for (int r = 0; r < box.height; ++r) {
+      for (int c = 0; c < box.width; ++c) {
+        const int gc = box.x + c, gr = box.y + r;
+        const uint8_t* p = &(*rgba)[4 * (static_cast<size_t>(gr) * grid.width + gc)];
+        bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(p[2], p[1], p[0]);
+        has.at<uint8_t>(r, c) = p[3] ? 255 : 0;
+        const bool g = !p[3] && !std::isnan(grid.at(gc, gr));
+        gap.at<uint8_t>(r, c) = g ? 255 : 0;
+        any = any || (g && tile.contains({gc, gr}));
+      }
+    }
+    if (!any) return;
+    cv::Mat near;
+    cv::dilate(
+        has, near,
+        cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kGapCells + 1, 2 * kGapCells + 1)));
+    gap &= near;
+    if (cv::countNonZero(gap) == 0) return;
+    cv::Mat painted;
+    cv::inpaint(bgr, gap, painted, kGapCells, cv::INPAINT_TELEA);
+    // Only the tile's own cells: its neighbours write theirs.
+    for (int gr = tile.y; gr < tile.y + tile.height; ++gr) {
+      for (int gc = tile.x; gc < tile.x + tile.width; ++gc) {
+        const int r = gr - box.y, c = gc - box.x;
+        if (!gap.at<uint8_t>(r, c)) continue;
+        fills[t].emplace_back(static_cast<size_t>(gr) * grid.width + gc,
+                              painted.at<cv::Vec3b>(r, c));
+      }
+    }
+  });
+  long n = 0;
+  for (const auto& tile : fills) {
+    for (const auto& [i, v] : tile) {
+      uint8_t* q = &(*rgba)[4 * i];
       q[0] = v[2], q[1] = v[1], q[2] = v[0], q[3] = 255;
     }
+    n += static_cast<long>(tile.size());
   }
   return n;
 }
