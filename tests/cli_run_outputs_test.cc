@@ -20,8 +20,10 @@
 #include <vector>
 
 #include "cli_test_util.h"
+#include "ortho_truth_metrics.h"
 #include "sapmvs/io/las_io.h"
 #include "sapmvs/io/ply_io.h"
+#include "sapmvs/io/raster_io.h"
 #include "sapmvs/run/cloud_las.h"
 #include "test_util.h"
 
@@ -250,6 +252,26 @@ TEST_F(CliRunOutputsTest, OrthoIsACogOnTheDsmsGround) {
   ASSERT_EQ(world.size(), 6u);
   EXPECT_NEAR(png.cols * world[0], w * b[1], world[0]);
   EXPECT_DOUBLE_EQ(world[4], b[0] + world[0] / 2);
+}
+
+// The demo block's ortho against the simulator's true orthophoto: where it
+// lies (phase correlation in tiles) and whether roofs stay on their
+// footprints where the run's DSM is right.
+TEST_F(CliRunOutputsTest, OrthoFollowsTheTruth) {
+  const fs::path out = Out("1.2");
+  const fs::path truth = test::Simulated("tiny", 1) / "truth";
+  const GeoRaster run_dsm = ReadGeoRaster(out / "dsm.tif");
+  OrthoTruthOptions options;
+  options.tile = 32;  // the demo block is small
+  const OrthoTruth r =
+      CompareOrthoToTruth(ReadColorRaster(out / "ortho.tif"), ReadColorRaster(truth / "ortho.tif"),
+                          ReadGeoRaster(truth / "dsm.tif"), options, &run_dsm);
+  ASSERT_GE(r.tiles_used, 3);  // 5 of 12 at 32 cells
+  EXPECT_LE(r.shift_median, 0.5);
+  EXPECT_LE(r.shift_p95, 1.5);
+  EXPECT_LT(std::abs(r.luminance_bias), 5);
+  ASSERT_GE(r.high_right.cells, 50);
+  EXPECT_LE(r.high_right.Share(), 0.05);
 }
 
 }  // namespace
