@@ -399,23 +399,25 @@ Eigen::Vector3d Scene::Albedo(const Hit& hit) const {
     const double n = tex(along, z * 1.3, 11, 1 / 6.0);
     return Eigen::Vector3d(0.72, 0.68, 0.60) * (0.55 + 0.8 * n) + 0.15 * feat;
   }
-  const double large = tex(x, y, 1, 1 / 40.0), fine = tex(x, y, 2, 1 / 3.0);
+  // Each noise only where a class uses it: they are most of a ray's cost.
+  auto large = [&] { return tex(x, y, 1, 1 / 40.0); };
+  auto fine = [&] { return tex(x, y, 2, 1 / 3.0); };
   switch (hit.cls) {
     case SurfaceClass::kGrass:
-      return Eigen::Vector3d(0.22, 0.38, 0.12) * (0.3 + 0.5 * large + 0.9 * fine);
+      return Eigen::Vector3d(0.22, 0.38, 0.12) * (0.3 + 0.5 * large() + 0.9 * fine());
     case SurfaceClass::kBareSoil:
-      return Eigen::Vector3d(0.50, 0.40, 0.28) * (0.35 + 0.4 * large + 0.8 * fine);
+      return Eigen::Vector3d(0.50, 0.40, 0.28) * (0.35 + 0.4 * large() + 0.8 * fine());
     case SurfaceClass::kRoad:
-      return Eigen::Vector3d(0.33, 0.33, 0.35) * (0.45 + 0.3 * large + 0.8 * fine);
+      return Eigen::Vector3d(0.33, 0.33, 0.35) * (0.45 + 0.3 * large() + 0.8 * fine());
     case SurfaceClass::kSquare:
-      return Eigen::Vector3d(0.62, 0.56, 0.48) * (0.4 + 0.3 * large + 0.8 * fine);
+      return Eigen::Vector3d(0.62, 0.56, 0.48) * (0.4 + 0.3 * large() + 0.8 * fine());
     case SurfaceClass::kRoof:
-      return feat * (0.35 + 0.3 * large + 1.0 * tex(x, y, 3, 1 / 2.0));
+      return feat * (0.35 + 0.3 * large() + 1.0 * tex(x, y, 3, 1 / 2.0));
     case SurfaceClass::kTree:
       return feat * (0.35 + 1.3 * tex(x, y, 4, 1 / 1.5));
     case SurfaceClass::kWater:
       // Nearly textureless, as real water is for a matcher.
-      return Eigen::Vector3d(0.05, 0.09, 0.13) * (0.98 + 0.04 * large);
+      return Eigen::Vector3d(0.05, 0.09, 0.13) * (0.98 + 0.04 * large());
   }
   return {0.5, 0.5, 0.5};
 }
