@@ -46,11 +46,12 @@ GeoRaster BoxDsm() {
   return r;
 }
 
-// Looking straight down from `center`, 1000 x 1000 px, f = 100 px.
+// Looking straight down from `center`, 500 x 500 px, f = 50 px: 0.8 m
+// pixels on the ground from 40 m, 0.5 m cells of the ortho.
 Camera NadirCamera(const Eigen::Vector3d& center) {
   Eigen::Matrix3d r_wc;
   r_wc << 1, 0, 0, 0, -1, 0, 0, 0, -1;
-  return Camera(Intrinsics::FromPixels(100, 100, 499.5, 499.5, 1000, 1000), r_wc, center);
+  return Camera(Intrinsics::FromPixels(50, 50, 249.5, 249.5, 500, 500), r_wc, center);
 }
 
 // RGB of the ground, smooth enough for bilinear sampling at 1 px.

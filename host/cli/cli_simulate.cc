@@ -44,8 +44,11 @@ void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global) {
   cmd->add_option("--noise", o->noise, "Sensor noise, grey levels (1 sigma)")
       ->capture_default_str();
   cmd->add_flag("--xyz", o->xyz, "Also write truth/lidar.xyz");
-  cmd->callback([o, &global] {
+  auto no_ortho = std::make_shared<bool>(false);
+  cmd->add_flag("--no-truth-ortho", *no_ortho, "Do not write truth/ortho.tif");
+  cmd->callback([o, no_ortho, &global] {
     o->quiet = global.quiet;
+    o->ortho = !*no_ortho;
     const SimulateSummary s = Simulate(*o);
     std::cout << "simulated " << s.images << " images of " << s.width << "x" << s.height
               << " px in " << s.strips << " strips, GSD " << s.gsd << " m at " << s.flying_height

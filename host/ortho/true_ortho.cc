@@ -29,7 +29,7 @@ constexpr int kObjectMarginCells = 2;
 constexpr double kSeenToleranceCells = 1.5;
 // Gaps no image sees are inpainted up to this many cells from a colour.
 constexpr int kGapCells = 4;
-// Images decoded at once for the colours, at most.
+// Images decoded, and depth buffers held, at once, at most.
 constexpr int kImagesAtOnce = 4;
 
 struct OrthoView {
@@ -195,7 +195,8 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
   // object's view where that one sees it. On the DSM's cells: the DSM
   // decides what each image sees, and the blend below smooths the seams
   // between its cells. The views run side by side, each drawing its own
-  // depth buffer; a cell's best (directness, view) is one 64-bit word that
+  // depth buffer (at most kImagesAtOnce of them: a 20 MP image's at level 0
+  // is 80 MB); a cell's best (directness, view) is one 64-bit word that
   // they raise atomically: a positive float's bits order as the float.
   const size_t dsm_cells = dsm.values.size();
   std::vector<std::atomic<uint64_t>> best(dsm_cells);
@@ -228,7 +229,7 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
           }
         }
       },
-      1);
+      1, kImagesAtOnce);
   std::vector<int> label(dsm_cells, -1);
   for (size_t i = 0; i < dsm_cells; ++i) {
     const uint64_t word = best[i].load(std::memory_order_relaxed);

@@ -287,11 +287,13 @@ SimulateSummary Simulate(const SimulateOptions& o) {
       classes.at(col, row) = sim::LasClass(scene.CellClass(col, dsm.height - 1 - row));
   WriteGeoTiff(o.out / "truth" / "classes.tif", classes);
   // The true orthophoto, at the images' nominal GSD over the DSM's extent.
-  sim::TrueOrtho ortho = sim::RenderTrueOrtho(scene, flight.gsd, o.supersampling);
-  ortho.grid.origin_x += offset.x();
-  ortho.grid.origin_y += offset.y();
-  ortho.grid.crs = kCrs;
-  WriteColorGeoTiff(o.out / "truth" / "ortho.tif", ortho.grid, ortho.rgba);
+  if (o.ortho) {
+    sim::TrueOrtho ortho = sim::RenderTrueOrtho(scene, flight.gsd, o.supersampling);
+    ortho.grid.origin_x += offset.x();
+    ortho.grid.origin_y += offset.y();
+    ortho.grid.crs = kCrs;
+    WriteColorGeoTiff(o.out / "truth" / "ortho.tif", ortho.grid, ortho.rgba);
+  }
 
   sim::LidarSpec lidar;
   lidar.density = sim::LidarDensityForGsd(flight.gsd);
@@ -334,10 +336,15 @@ SimulateSummary Simulate(const SimulateOptions& o) {
          << " m cells (flat-topped: walls are vertical).\n"
          << "- `truth/classes.tif`: the LAS class of each DSM cell (2 ground, 5 vegetation, "
             "6 building, 9 water).\n"
-         << "- `truth/ortho.tif`: the true orthophoto (RGBA, alpha 0 outside the scene), "
-         << Fixed(flight.gsd, 4) << " m cells from the DSM's north-west corner: the cell tops "
-         << "as seen straight down, " << o.supersampling << "x" << o.supersampling
-         << " points per cell, recorded with gain 1 and the images' tone curve, no noise.\n"
+         << (o.ortho ? "- `truth/ortho.tif`: the true orthophoto (RGBA, alpha 0 outside the "
+                       "scene), " +
+                           Fixed(flight.gsd, 4) +
+                           " m cells from the DSM's north-west corner: the cell tops as seen "
+                           "straight down, " +
+                           std::to_string(o.supersampling) + "x" + std::to_string(o.supersampling) +
+                           " points per cell, recorded with gain 1 and the images' tone curve, no "
+                           "noise.\n"
+                     : std::string())
          << "- `truth/lidar.las`" << (o.xyz ? " and `truth/lidar.xyz`" : "") << ": "
          << points.size() << " simulated first returns, " << Fixed(lidar.density, 2)
          << " points/m^2 per strip, "

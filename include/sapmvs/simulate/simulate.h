@@ -38,7 +38,10 @@ struct SimulateOptions {
   int supersampling = 2;  // rays per pixel side (2 = 2x2 per pixel), at least 2
   double noise = 1.5;     // sensor noise, standard deviation in 8-bit grey levels
   bool xyz = false;       // also write truth/lidar.xyz
-  bool quiet = false;     // no progress bar
+  // Write truth/ortho.tif, the true orthophoto (about a sixth of a small
+  // block's render time).
+  bool ortho = true;
+  bool quiet = false;  // no progress bar
 
   // Empty when the options are usable, else one line naming the bad value.
   std::string Problem() const;
