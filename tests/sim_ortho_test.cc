@@ -93,8 +93,8 @@ TEST(SimOrtho, CellsAreTheRecordedShadeOfTheTopAtTheirCentre) {
 // The tiny block's truth/ortho.tif on truth/dsm.tif's extent, at the nominal
 // GSD, coloured by the scene BuildWorld rebuilds.
 TEST(SimOrtho, FileOfTheTinyBlock) {
-  const fs::path dir = test::Simulated("tiny", 3);
-  SimulateOptions o = test::SimulatedOptions("tiny", 3);
+  const fs::path dir = test::Simulated("tiny", 1);
+  SimulateOptions o = test::SimulatedOptions("tiny", 1);
   o.out = dir;
   const SimulatedWorld world = BuildWorld(o);
   const ColorRaster ortho = ReadColorRaster(dir / "truth" / "ortho.tif");
