@@ -69,8 +69,8 @@ std::filesystem::path SharedFolder(const std::string& id,
                                    const std::filesystem::path& root = {});
 
 // The options Simulated() runs the simulator with (quiet, truth/lidar.xyz
-// too), without `out`: a test can rebuild the same world or render the same
-// block again.
+// too, truth/ortho.tif for tiny seed 1 at full scale only), without `out`:
+// a test can rebuild the same world or render the same block again.
 SimulateOptions SimulatedOptions(const std::string& preset, int seed, double scale = 1.0);
 // The simulator's `preset` rendered with `seed` at `scale` (a SharedFolder).
 // Read only: a test that needs a changed block copies it. The simulator is
