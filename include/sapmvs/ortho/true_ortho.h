@@ -8,10 +8,10 @@
 // For each cell, the image that sees it most directly (its ray nearest the
 // vertical) among those that see it at all: visibility is decided against
 // the DSM drawn into each image's depth buffer (ortho_depth_buffer.h).
-// Objects (steep DSM cells, ortho_surface.h) are each taken whole from the
-// image that sees the most of them, so that the seams where the chosen image
-// changes run over open ground; across a seam the colours are blended over
-// a few cells. Narrow gaps no image sees are inpainted from around them;
+// Objects (steep DSM cells, ortho_surface.h) are each taken, wherever it
+// sees them, from the image that looks most directly at their centre, so
+// that the seams where the chosen image changes run over open ground;
+// across a seam the colours are blended over a few cells. Narrow gaps no image sees are inpainted from around them;
 // wider ones, and cells without a DSM height, stay empty (alpha 0).
 
 #include <cstdint>
