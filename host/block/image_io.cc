@@ -155,4 +155,23 @@ cv::Mat ResampleToLevel(const cv::Mat& image, int level, int width, int height) 
   return out;
 }
 
+Eigen::Vector3d BilinearBgr(const cv::Mat& bgr, double x, double y) {
+  x = std::clamp(x, 0.0, bgr.cols - 1.0);
+  y = std::clamp(y, 0.0, bgr.rows - 1.0);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int x1 = std::min(x0 + 1, bgr.cols - 1), y1 = std::min(y0 + 1, bgr.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  const cv::Vec3b& a = bgr.at<cv::Vec3b>(y0, x0);
+  const cv::Vec3b& b = bgr.at<cv::Vec3b>(y0, x1);
+  const cv::Vec3b& c = bgr.at<cv::Vec3b>(y1, x0);
+  const cv::Vec3b& d = bgr.at<cv::Vec3b>(y1, x1);
+  Eigen::Vector3d out;
+  for (int k = 0; k < 3; ++k) {
+    const double top = a[k] + fx * (b[k] - a[k]);
+    const double bottom = c[k] + fx * (d[k] - c[k]);
+    out[k] = top + fy * (bottom - top);
+  }
+  return out;
+}
+
 }  // namespace sapmvs

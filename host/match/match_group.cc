@@ -18,6 +18,7 @@
 #include "match/patch_filter.h"
 #include "match/propagation.h"
 #include "match/seed_matcher.h"
+#include "sapmvs/block/image_io.h"
 #include "sapmvs/util/cpu_time.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
@@ -48,22 +49,9 @@ KernelTime KernelTotals(const std::vector<const PatchEngine*>& engines) {
 // centre, a pixel corner, where rounding to one of the four pixels picked
 // whichever the float32 projection fell nearer.
 std::array<uint8_t, 3> ColourAt(const cv::Mat& bgr, const Eigen::Vector2f& uv) {
-  const double x = std::clamp(static_cast<double>(uv.x()), 0.0, bgr.cols - 1.0);
-  const double y = std::clamp(static_cast<double>(uv.y()), 0.0, bgr.rows - 1.0);
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const int x1 = std::min(x0 + 1, bgr.cols - 1), y1 = std::min(y0 + 1, bgr.rows - 1);
-  const double fx = x - x0, fy = y - y0;
-  const cv::Vec3b& a = bgr.at<cv::Vec3b>(y0, x0);
-  const cv::Vec3b& b = bgr.at<cv::Vec3b>(y0, x1);
-  const cv::Vec3b& c = bgr.at<cv::Vec3b>(y1, x0);
-  const cv::Vec3b& d = bgr.at<cv::Vec3b>(y1, x1);
-  std::array<uint8_t, 3> rgb;
-  for (int k = 0; k < 3; ++k) {
-    const double top = a[k] + fx * (b[k] - a[k]);
-    const double bottom = c[k] + fx * (d[k] - c[k]);
-    rgb[2 - k] = static_cast<uint8_t>(std::lround(top + fy * (bottom - top)));
-  }
-  return rgb;
+  const Eigen::Vector3d c = BilinearBgr(bgr, uv.x(), uv.y());
+  return {static_cast<uint8_t>(std::lround(c[2])), static_cast<uint8_t>(std::lround(c[1])),
+          static_cast<uint8_t>(std::lround(c[0]))};
 }
 
 }  // namespace

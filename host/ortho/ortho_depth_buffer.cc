@@ -17,6 +17,7 @@ OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
   // for a centre that is empty or behind the camera.
   const int n = window.col1 - window.col0 + 1;
   std::vector<Eigen::Vector3d> above(n), below(n);
+  const Eigen::Matrix3d k = camera.intrinsics().K();
   auto project_row = [&](int r, std::vector<Eigen::Vector3d>* out) {
     for (int i = 0; i < n; ++i) {
       const int c = window.col0 + i;
@@ -25,7 +26,7 @@ OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
       const Eigen::Vector2d xy = dsm.CellCenter(c, r);
       const Eigen::Vector3d cam = camera.ToCamera({xy.x(), xy.y(), dsm.at(c, r)});
       if (!(cam.z() > 0)) continue;
-      const Eigen::Vector3d uvw = camera.intrinsics().K() * cam;
+      const Eigen::Vector3d uvw = k * cam;
       (*out)[i] = Eigen::Vector3d(uvw.x() / uvw.z(), uvw.y() / uvw.z(), cam.z());
     }
   };

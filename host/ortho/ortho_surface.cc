@@ -8,6 +8,7 @@
 
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/number_text.h"
+#include "sapmvs/util/parallel_for.h"
 
 namespace sapmvs {
 namespace {
@@ -160,13 +161,13 @@ OrthoSurface MakeOrthoSurface(const GeoRaster& source, double cell, double objec
   for (int r = 0; r < g.height; ++r) {
     s.dsm_row[r] = std::min(dsm.height - 1, static_cast<int>((r + 0.5) * cell / dsm.cell_size));
   }
-#pragma omp parallel for schedule(static)
-  for (int r = 0; r < g.height; ++r) {
+  ParallelFor(g.height, [&](long r) {
     for (int c = 0; c < g.width; ++c) {
-      const Eigen::Vector2d p = g.CellCenter(c, r);
-      g.at(c, r) = InterpolateHeight(dsm, p.x(), p.y(), object_slope * dsm.cell_size);
+      const Eigen::Vector2d p = g.CellCenter(c, static_cast<int>(r));
+      g.at(c, static_cast<int>(r)) =
+          InterpolateHeight(dsm, p.x(), p.y(), object_slope * dsm.cell_size);
     }
-  }
+  });
   s.zmin = std::numeric_limits<double>::infinity();
   s.zmax = -s.zmin;
   for (int r = 0; r < dsm.height; ++r) {

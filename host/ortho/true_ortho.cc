@@ -45,24 +45,6 @@ float Directness(const Camera& camera, const Eigen::Vector3d& x) {
   return static_cast<float>((camera.center() - x).normalized().z());
 }
 
-// Bilinear, edge pixels repeated: `uv` is inside the image (Sees).
-Eigen::Vector3f SampleBgr(const cv::Mat& bgr, const Eigen::Vector2d& uv) {
-  const double x = std::clamp(uv.x(), 0.0, bgr.cols - 1.0),
-               y = std::clamp(uv.y(), 0.0, bgr.rows - 1.0);
-  const int x0 = std::min(static_cast<int>(x), bgr.cols - 2 < 0 ? 0 : bgr.cols - 2);
-  const int y0 = std::min(static_cast<int>(y), bgr.rows - 2 < 0 ? 0 : bgr.rows - 2);
-  const int x1 = std::min(x0 + 1, bgr.cols - 1), y1 = std::min(y0 + 1, bgr.rows - 1);
-  const float tx = static_cast<float>(x - x0), ty = static_cast<float>(y - y0);
-  Eigen::Vector3f out;
-  for (int ch = 0; ch < 3; ++ch) {
-    const float top = (1 - tx) * bgr.at<cv::Vec3b>(y0, x0)[ch] + tx * bgr.at<cv::Vec3b>(y0, x1)[ch];
-    const float bottom =
-        (1 - tx) * bgr.at<cv::Vec3b>(y1, x0)[ch] + tx * bgr.at<cv::Vec3b>(y1, x1)[ch];
-    out[ch] = (1 - ty) * top + ty * bottom;
-  }
-  return out;
-}
-
 Eigen::Vector3d CellPoint(const GeoRaster& grid, int col, int row) {
   const Eigen::Vector2d xy = grid.CellCenter(col, row);
   return {xy.x(), xy.y(), grid.at(col, row)};
@@ -306,7 +288,7 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
           if (w == 0 || std::isnan(grid.at(gc, gr))) continue;
           Eigen::Vector2d uv;
           if (!depth.Sees(CellPoint(grid, gc, gr), &uv)) continue;
-          const Eigen::Vector3f bgr = SampleBgr(pixels, uv);
+          const Eigen::Vector3d bgr = BilinearBgr(pixels, uv.x(), uv.y());
           uint16_t* s = &sum[4 * (static_cast<size_t>(gr) * grid.width + gc)];
           for (int ch = 0; ch < 3; ++ch)
             s[ch] += static_cast<uint16_t>(std::lround(w * bgr[2 - ch]));

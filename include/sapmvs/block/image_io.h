@@ -2,6 +2,7 @@
 // Reading images: sizes from the file header (GDAL, no decoding), pixels
 // through OpenCV, undistortion once at load so the matcher sees pinhole images.
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
@@ -50,5 +51,10 @@ LoadedImage LoadUndistorted(const BlockImage& image);
 // 2i + 0.5 as Intrinsics::Scaled assumes (pyrDown would centre it at 2i),
 // then resized to the camera's size where the rounding of odd sides differs.
 cv::Mat ResampleToLevel(const cv::Mat& image, int level, int width, int height);
+
+// The colour of an 8-bit BGR image at pixel coordinates (x, y) (pixel
+// (0, 0)'s centre at 0), bilinear between the four pixels around it, border
+// pixels repeated; BGR, unrounded.
+Eigen::Vector3d BilinearBgr(const cv::Mat& bgr, double x, double y);
 
 }  // namespace sapmvs
