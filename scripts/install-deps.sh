@@ -3,8 +3,9 @@
 # already present are left alone, so a second run only costs the apt checks.
 #
 #   scripts/install-deps.sh           everything: building, the tests, the
-#                                     sanitizer and fuzzing toolchain, and the
-#                                     npm LAS readers the tests compare with
+#                                     sanitizer and fuzzing toolchain, the
+#                                     headless browser and the npm LAS readers
+#                                     the tests check outputs with
 #   scripts/install-deps.sh --build   only what building and running sapmvs
 #                                     needs (scripts/demo.sh): on a fresh
 #                                     Debian 12 machine clang, LLVM and the npm
@@ -31,7 +32,8 @@ PACKAGES=(
 )
 # scripts/fuzz.sh and test.sh --sanitize: clang with its sanitizer and
 # libFuzzer runtimes and its OpenMP; the symbolizer for sanitizer reports.
-[ "$build_only" = 1 ] || PACKAGES+=(clang libclang-rt-14-dev libomp-dev llvm)
+# The tests that open report.html in a headless browser (12 s of apt).
+[ "$build_only" = 1 ] || PACKAGES+=(clang libclang-rt-14-dev libomp-dev llvm chromium)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -153,6 +153,30 @@ TEST_F(CliEvaluateTest, DsmReferenceWithAFootprintReportsCompleteness) {
       << r.out;
 }
 
+// --run: the evaluation goes into a run's folder and its report.html.
+TEST_F(CliEvaluateTest, RunPutsTheEvaluationInTheRunsReport) {
+  const fs::path run = dir_ / "run";
+  fs::create_directories(run);
+  const std::string command = "evaluate " + (dir_ / "cloud.ply").string() + " --reference " +
+                              (dir_ / "lidar.las").string() + " -q --run " + run.string();
+  // Not a run's folder: refused before any work, naming it.
+  auto r = RunCli(command);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(run.string() + ": --run expects a folder"), std::string::npos) << r.err;
+  std::ofstream(run / "report.json") << R"({"report_version": 2, "groups": [], "points": 71})";
+  r = RunCli(command);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(run / "evaluation.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["rows"][0]["checkpoints"], 69);
+  for (const char* name : {"dz_histogram.png", "dz_map.png", "pseudo_errors.png"}) {
+    EXPECT_TRUE(fs::exists(run / "evaluation" / name)) << name;
+  }
+  const std::string page = test::Slurp(run / "report.html");
+  EXPECT_NE(page.find("id=\"evaluation\""), std::string::npos);
+  EXPECT_NE(page.find(">69<"), std::string::npos);  // the checkpoints, no threshold
+}
+
 TEST_F(CliEvaluateTest, MissingFileIsOneLineAndExitCode1) {
   const auto r =
       RunCli("evaluate /nonexistent/cloud.ply --reference " + (dir_ / "lidar.las").string());

@@ -64,13 +64,14 @@ TEST_F(CliMpiTest, TwoRanksWriteTheCloudOfOneProcess) {
       RunRanks(2, "-q run " + Block().string() + " --out " + two.string() + " " + kTwoGroups);
   ASSERT_EQ(r2.exit_code, 0) << r2.err;
   EXPECT_EQ(test::Slurp(one / "cloud.ply"), test::Slurp(two / "cloud.ply"));
-  for (const char* f : {"cloud.las", "dsm.tif", "dsm.png", "ortho.tif", "report.json"}) {
+  for (const char* f :
+       {"cloud.las", "dsm.tif", "dsm.png", "ortho.tif", "report.json", "report.html"}) {
     EXPECT_TRUE(fs::exists(two / f)) << f;
   }
   // Rank 0 alone prints the summary; the claims are gone.
   size_t wrote = 0;
   for (size_t at = 0; (at = r2.out.find("wrote ", at)) != std::string::npos; ++at) ++wrote;
-  EXPECT_EQ(wrote, 10u) << r2.out;
+  EXPECT_EQ(wrote, 11u) << r2.out;
   for (const auto& e : fs::directory_iterator(two / "groups")) {
     EXPECT_NE(e.path().extension(), ".claim") << e.path();
   }

@@ -274,5 +274,26 @@ TEST_F(CliRunOutputsTest, OrthoFollowsTheTruth) {
   EXPECT_LE(r.high_right.Share(), 0.05);
 }
 
+// report.html of a real run: self-contained, and a browser decodes every
+// picture in it (the DSM and the orthophoto at least) and logs nothing.
+TEST_F(CliRunOutputsTest, ReportOpensInABrowser) {
+  const fs::path html = Out("1.2") / "report.html";
+  ASSERT_TRUE(fs::exists(html));
+  const std::string page = test::Slurp(html);
+  EXPECT_EQ(page.find("src=\"http"), std::string::npos);
+  EXPECT_EQ(page.find("href=\"http"), std::string::npos);
+  size_t pictures = 0;
+  for (size_t at = page.find("<img "); at != std::string::npos; at = page.find("<img ", at + 1)) {
+    ++pictures;
+  }
+  EXPECT_GE(pictures, 2u);
+  const test::BrowserPage loaded = test::LoadInHeadlessBrowser(html);
+  SAPMVS_REQUIRE_BROWSER(loaded);
+  const std::string want =
+      "data-pictures-decoded=\"" + std::to_string(pictures) + "/" + std::to_string(pictures) + "\"";
+  EXPECT_NE(loaded.dom.find(want), std::string::npos) << want;
+  EXPECT_TRUE(loaded.console.empty()) << loaded.console.front();
+}
+
 }  // namespace
 }  // namespace sapmvs

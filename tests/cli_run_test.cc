@@ -222,6 +222,7 @@ TEST_F(CliRunTest, WritesCloudAndReport) {
                                           "ortho.png",
                                           "ortho.pgw",
                                           "report.json",
+                                          "report.html",
                                           "groups/plan.json",
                                           "groups/group_001.ply",
                                           "groups/group_001.json"};

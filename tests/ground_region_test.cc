@@ -35,6 +35,40 @@ TEST(GroundRegion, IsTheVoronoiCellOfItsCentre) {
   }
 }
 
+double PolygonArea(const std::vector<Eigen::Vector2d>& p) {
+  double twice = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const Eigen::Vector2d& a = p[i];
+    const Eigen::Vector2d& b = p[(i + 1) % p.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return twice / 2;  // > 0 counter-clockwise
+}
+
+TEST(GroundRegion, OutlinesTileTheBox) {
+  const Eigen::Vector2d lo(499950, 5399950), hi(500150, 5400110);
+  double area = 0;
+  for (int g = 0; g < 3; ++g) {
+    const std::vector<Eigen::Vector2d> outline = GroundRegion(kCenters, g, 0).Outline(lo, hi);
+    ASSERT_GE(outline.size(), 3u) << g;
+    EXPECT_GT(PolygonArea(outline), 0) << g;
+    area += PolygonArea(outline);
+    // Its corners lie in the box and in the region (on its edges, within
+    // rounding): the mean of the corners lies inside.
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& p : outline) {
+      EXPECT_TRUE((p.array() >= lo.array() - 1e-6).all() && (p.array() <= hi.array() + 1e-6).all());
+      EXPECT_TRUE(GroundRegion(kCenters, g, 1e-6).Contains(p)) << g << ": " << p.transpose();
+      mean += p / outline.size();
+    }
+    EXPECT_TRUE(GroundRegion(kCenters, g, 0).Contains(mean)) << g;
+  }
+  EXPECT_NEAR(area, (hi - lo).prod(), 1e-3);
+  // One group: the whole box; a box beyond a region: nothing.
+  EXPECT_NEAR(PolygonArea(GroundRegion().Outline(lo, hi)), (hi - lo).prod(), 1e-6);
+  EXPECT_TRUE(GroundRegion(kCenters, 0, 0).Outline({500080, 5399950}, {500150, 5400000}).empty());
+}
+
 TEST(GroundRegion, TheMarginReachesIntoTheNeighboursGround) {
   const GroundRegion r(kCenters, 0, 5);
   EXPECT_TRUE(r.Contains({500054.9, 5400000.0}));

@@ -20,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <stdexcept>
 
 namespace sapmvs::test {
 
@@ -116,6 +117,47 @@ fs::path Simulated(const std::string& preset, int seed, double scale) {
 bool OpenClRequired() {
   const char* env = std::getenv("SAPMVS_REQUIRE_OPENCL");
   return env && std::string(env) == "1";
+}
+
+bool BrowserRequired() {
+  const char* env = std::getenv("SAPMVS_REQUIRE_BROWSER");
+  return env && std::string(env) == "1";
+}
+
+BrowserPage LoadInHeadlessBrowser(const std::filesystem::path& html) {
+  BrowserPage page;
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+    const std::string which = std::string("command -v ") + name + " >/dev/null 2>&1";
+    if (std::system(which.c_str()) == 0) {
+      page.browser = name;
+      break;
+    }
+  }
+  if (page.browser.empty()) return page;
+  static int calls = 0;
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("sapmvs_browser_" + std::to_string(getpid()) + "_" + std::to_string(calls++));
+  std::filesystem::create_directories(dir);
+  // --no-sandbox: the tests may run as root, where Chromium's sandbox will
+  // not start. Console messages go to stderr as INFO:CONSOLE lines.
+  const std::string cmd = "timeout 120 " + page.browser +
+                          " --headless --no-sandbox --disable-gpu --no-first-run "
+                          "--user-data-dir=" +
+                          (dir / "profile").string() +
+                          " --enable-logging=stderr --v=0 --dump-dom 'file://" +
+                          std::filesystem::absolute(html).string() + "' > " +
+                          (dir / "dom.html").string() + " 2> " + (dir / "stderr.txt").string();
+  if (std::system(cmd.c_str()) != 0) {
+    throw std::runtime_error("failed: " + cmd + "\n" + Slurp(dir / "stderr.txt"));
+  }
+  page.dom = Slurp(dir / "dom.html");
+  std::istringstream err(Slurp(dir / "stderr.txt"));
+  for (std::string line; std::getline(err, line);) {
+    if (line.find(":CONSOLE") != std::string::npos) page.console.push_back(line);
+  }
+  std::filesystem::remove_all(dir);
+  return page;
 }
 
 std::filesystem::path HerzJesu() { return SharedDir() / "datasets/strecha_herzjesu/Herz-Jesus-P8"; }

@@ -171,6 +171,32 @@ bool OpenClRequired();
     GTEST_SKIP() << (why);                                                                 \
   } while (0)
 
+namespace sapmvs::test {
+// What a headless Chromium (Debian's `chromium`) made of a page: the DOM
+// after the load event, and every console message (errors, uncaught
+// exceptions, logs) it printed. `browser` is empty when none is installed.
+struct BrowserPage {
+  std::string browser;
+  std::string dom;
+  std::vector<std::string> console;
+};
+BrowserPage LoadInHeadlessBrowser(const std::filesystem::path& html);
+// Whether SAPMVS_REQUIRE_BROWSER=1 (scripts/test.sh sets it, having
+// installed Chromium): then a test without a browser fails, not skips.
+bool BrowserRequired();
+}  // namespace sapmvs::test
+
+// Skips the current test when `page` found no browser; fails it instead when
+// BrowserRequired().
+#define SAPMVS_REQUIRE_BROWSER(page)                                                   \
+  do {                                                                                 \
+    if ((page).browser.empty()) {                                                      \
+      if (::sapmvs::test::BrowserRequired())                                           \
+        FAIL() << "no headless browser (chromium) on PATH (SAPMVS_REQUIRE_BROWSER=1)"; \
+      GTEST_SKIP() << "no headless browser (chromium) on PATH";                        \
+    }                                                                                  \
+  } while (0)
+
 // Skips the current test, naming the missing path, when `path` does not exist.
 #define SAPMVS_REQUIRE_PATH(path)                                 \
   do {                                                            \

@@ -65,6 +65,7 @@ void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterRunCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterPlanCommand(CLI::App& app, const GlobalFlags& global);
 void RegisterExportCommand(CLI::App& app, const GlobalFlags& global);
+void RegisterReportCommand(CLI::App& app, const GlobalFlags& global);
 // Hidden: prints docs/options.md.
 void RegisterOptionsReferenceCommand(CLI::App& app, const GlobalFlags& global);
 

@@ -8,6 +8,7 @@
 
 #include "cli/cli.h"
 #include "sapmvs/evaluate/evaluate.h"
+#include "sapmvs/report/report_html.h"
 
 namespace sapmvs::cli {
 
@@ -40,6 +41,9 @@ void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global) {
   cmd->add_option("--json", o->json, "Write the report as JSON to FILE");
   cmd->add_option("--plots", o->plots,
                   "Write dz_histogram.png, dz_map.png, pseudo_errors.png into DIR");
+  cmd->add_option("--run", o->run,
+                  "A run folder: write evaluation.json and the plots (evaluation/) into it "
+                  "and add them to its report.html");
   cmd->callback([o, &global] {
     o->quiet = global.quiet;
     const EvaluationReport report = Evaluate(*o);
@@ -52,6 +56,12 @@ void RegisterEvaluateCommand(CLI::App& app, const GlobalFlags& global) {
       for (const auto& p : WriteEvaluationPlots(report, o->plots)) {
         std::cout << "plot          " << p.string() << "\n";
       }
+    }
+    if (!o->run.empty()) {
+      WriteEvaluationJson(report, o->run / "evaluation.json");
+      WriteEvaluationPlots(report, o->run / "evaluation");
+      const std::filesystem::path html = WriteReportHtml(o->run);
+      std::cout << "report        " << html.string() << "\n";
     }
   });
 }

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   sapmvs::cli::RegisterPlanCommand(app, global);
   sapmvs::cli::RegisterEvaluateCommand(app, global);
   sapmvs::cli::RegisterExportCommand(app, global);
+  sapmvs::cli::RegisterReportCommand(app, global);
   sapmvs::cli::RegisterOptionsReferenceCommand(app, global);
 
   int code = 0;

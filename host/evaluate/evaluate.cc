@@ -279,6 +279,10 @@ EvaluationReport Evaluate(const EvaluateOptions& options) {
                   " does not exist");
     }
   }
+  if (!options.run.empty() && !std::filesystem::is_regular_file(options.run / "report.json")) {
+    throw Error(options.run.string() +
+                ": --run expects a folder `sapmvs run` wrote (it has no report.json)");
+  }
   if (!options.plots.empty() && std::filesystem::exists(options.plots) &&
       !std::filesystem::is_directory(options.plots)) {
     throw Error(options.plots.string() + ": --plots expects a folder, this is a file");

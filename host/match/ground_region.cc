@@ -26,4 +26,24 @@ GroundRegion::GroundRegion(const std::vector<Eigen::Vector2d>& centers, int own,
   }
 }
 
+std::vector<Eigen::Vector2d> GroundRegion::Outline(const Eigen::Vector2d& lo,
+                                                   const Eigen::Vector2d& hi) const {
+  std::vector<Eigen::Vector2d> polygon = {
+      {lo.x(), lo.y()}, {hi.x(), lo.y()}, {hi.x(), hi.y()}, {lo.x(), hi.y()}};
+  // Sutherland-Hodgman: a convex polygon clipped by one half-plane at a time.
+  for (const HalfPlane& h : half_planes_) {
+    std::vector<Eigen::Vector2d> kept;
+    for (size_t i = 0; i < polygon.size(); ++i) {
+      const Eigen::Vector2d& a = polygon[i];
+      const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+      const double da = h.normal.dot(a) - h.offset, db = h.normal.dot(b) - h.offset;
+      if (da <= 0) kept.push_back(a);
+      if ((da < 0 && db > 0) || (da > 0 && db < 0)) kept.push_back(a + (b - a) * (da / (da - db)));
+    }
+    polygon = std::move(kept);
+    if (polygon.size() < 3) return {};
+  }
+  return polygon;
+}
+
 }  // namespace sapmvs

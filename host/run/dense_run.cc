@@ -29,6 +29,7 @@
 #include "sapmvs/match/match_group.h"
 #include "sapmvs/ortho/true_ortho.h"
 #include "sapmvs/plan/grouping.h"
+#include "sapmvs/report/report_html.h"
 #include "sapmvs/run/cloud_dsm.h"
 #include "sapmvs/run/cloud_las.h"
 #include "sapmvs/run/cloud_merge.h"
@@ -109,9 +110,15 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   report.start_time = std::chrono::system_clock::now();
   auto stage_start = start;
   double stage_cpu = ProcessCpuSeconds();
+  // The match stage resets the peak for each group (below), so its own peak
+  // is the largest of theirs.
+  double groups_peak = 0;
   auto end_stage = [&](const std::string& name) {
     const double cpu = ProcessCpuSeconds();
-    report.stages.push_back({name, Since(stage_start), cpu - stage_cpu});
+    report.stages.push_back(
+        {name, Since(stage_start), cpu - stage_cpu, std::max(groups_peak, PeakRssBytes())});
+    groups_peak = 0;
+    ResetPeakRss();
     LogDetail("run: " + name + " " + Seconds(report.stages.back().wall));
     stage_start = std::chrono::steady_clock::now();
     stage_cpu = cpu;
@@ -223,6 +230,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     run.points = static_cast<long>(result.cloud.points.size());
     run.memory.peak_rss_bytes = PeakRssBytes();
     run.memory.peak_device_bytes = kernels->PeakDeviceBytes();
+    groups_peak = std::max(groups_peak, run.memory.peak_rss_bytes);
     progress.EndGroup(run.points, run.memory.peak_rss_bytes, run.memory_estimate_bytes);
     AddStats(result.stats, &report.stats);
     for (const auto& [name, t] : result.stats.stages) {
@@ -276,6 +284,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   job.crs = block.crs;
   job.out = options.out;
   job.block = options.block;
+  RemoveRunEvaluation(options.out);
   const GeoRaster dsm = WriteMergedOutputs(job, &report, end_stage);
   if (!options.ortho.skip) {
     std::unique_ptr<Progress> bar;  // once the images to draw are known
@@ -299,6 +308,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   report.peak_rss_bytes = ProcessPeakRssBytes();
   report.end_time = std::chrono::system_clock::now();
   WriteRunReport(options, report, block, plan);
+  WriteReportHtml(options.out);
   return report;
 }
 
@@ -395,7 +405,7 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
   out << "total         " << report.total_seconds << " s, peak memory "
       << report.peak_rss_bytes / (1 << 20) << " MiB\n";
   for (const char* f : {"cloud.ply", "cloud.las", "dsm.tif", "dsm_color.tif", "dsm.png", "dsm.pgw",
-                        "ortho.tif", "ortho.png", "ortho.pgw", "report.json"}) {
+                        "ortho.tif", "ortho.png", "ortho.pgw", "report.json", "report.html"}) {
     if (std::string(f).rfind("ortho", 0) == 0 && report.ortho_cell == 0) continue;
     out << "wrote         " << (report.out / f).string() << "\n";
   }

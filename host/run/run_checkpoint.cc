@@ -70,10 +70,19 @@ void RemoveRunOutputs(const std::filesystem::path& out) {
   for (const char* f :
        {"cloud.ply", "cloud.las", "dsm.tif", "dsm.tif.aux.xml", "dsm.png", "dsm.pgw",
         "dsm_color.tif", "dsm_color.tif.aux.xml", "ortho.tif", "ortho.tif.aux.xml", "ortho.png",
-        "ortho.pgw", "report.json", "profile.csv", "profile.json"}) {
+        "ortho.pgw", "report.json", "report.html", "profile.csv", "profile.json"}) {
     std::filesystem::remove(out / f, ec);
   }
   RemoveCheckpoints(out / "groups");
+  RemoveRunEvaluation(out);
+}
+
+void RemoveRunEvaluation(const std::filesystem::path& out) {
+  std::error_code ec;
+  for (const char* f : {"evaluation.json", "evaluation/dz_histogram.png", "evaluation/dz_map.png",
+                        "evaluation/pseudo_errors.png", "evaluation"}) {
+    std::filesystem::remove(out / f, ec);  // the folder only when nothing else is in it
+  }
 }
 
 RunCheckpoints::RunCheckpoints(std::filesystem::path dir, const Block& block,

@@ -27,6 +27,9 @@ struct GroupCheckpoint {
 // and its side-car, dsm.png, report.json, profile.csv/json) and its
 // checkpoints in out/groups, by name: a user's other files there stay.
 void RemoveRunOutputs(const std::filesystem::path& out);
+// Removes what `sapmvs evaluate --run` put into `out` (evaluation.json, its
+// plots in evaluation/): it judged a cloud that is about to be replaced.
+void RemoveRunEvaluation(const std::filesystem::path& out);
 // plan.json and group_NNN.ply/.json/.claim in `dir`, and nothing else.
 void RemoveCheckpoints(const std::filesystem::path& dir);
 

@@ -6,6 +6,7 @@
 #include <iomanip>
 
 #include "sapmvs/io/raster_io.h"
+#include "sapmvs/match/ground_region.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/log.h"
@@ -140,6 +141,11 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["grouping"] = report.strategy;
   j["ungrouped"] = report.ungrouped;
   j["matcher"] = OptionsJson(options.matcher);
+  // The ground each group's points were kept on: the merge gives each XY to
+  // the group with the nearest centre, so the regions tile the cloud's box.
+  std::vector<Eigen::Vector2d> centers;
+  for (const ImageGroup& group : plan.groups)
+    centers.push_back(group.center + block.origin.head<2>());
   nlohmann::json groups = nlohmann::json::array();
   for (size_t g = 0; g < report.groups.size(); ++g) {
     const GroupRun& r = report.groups[g];
@@ -150,6 +156,14 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
     if (g < plan.groups.size()) {
       const Eigen::Vector2d c = plan.groups[g].center + block.origin.head<2>();
       e["center"] = {c.x(), c.y()};
+      const GroundRegion region =
+          centers.size() > 1 ? GroundRegion(centers, static_cast<int>(g), 0) : GroundRegion();
+      nlohmann::json outline = nlohmann::json::array();
+      for (const Eigen::Vector2d& p :
+           region.Outline(report.bounds_min.head<2>(), report.bounds_max.head<2>())) {
+        outline.push_back({p.x(), p.y()});
+      }
+      e["region"] = outline;
       e["memory_estimate_bytes"] = {{"device", plan.groups[g].memory.device_bytes},
                                     {"host", plan.groups[g].memory.host_bytes},
                                     {"total", plan.groups[g].memory.Total()}};
@@ -181,6 +195,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
     stages.push_back({{"stage", "run " + t.name},
                       {"wall_seconds", t.wall},
                       {"cpu_seconds", t.cpu},
+                      {"peak_rss_bytes", t.peak_rss_bytes},
                       {"hms", FormatHms(t.wall)}});
   }
   j["stages"] = stages;

@@ -66,6 +66,10 @@ struct EvaluateOptions {
   // Write dz_histogram.png, dz_map.png and pseudo_errors.png into this
   // folder (created when missing); empty = no plots.
   std::filesystem::path plots;
+  // A folder `sapmvs run` wrote: the report also goes into it as
+  // evaluation.json, the plots into its evaluation/, and its report.html is
+  // made again with them (report/report_html.h). Empty = none.
+  std::filesystem::path run;
   // No progress bar.
   bool quiet = false;
 

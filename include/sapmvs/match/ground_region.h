@@ -27,6 +27,9 @@ class GroundRegion {
     return true;
   }
   bool Unbounded() const { return half_planes_.empty(); }
+  // The region within the box [lo, hi] (world XY): a convex polygon, its
+  // corners counter-clockwise; empty when the two do not meet.
+  std::vector<Eigen::Vector2d> Outline(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
 
  private:
   // n . xy <= offset, n the unit direction to the other centre.

@@ -85,12 +85,15 @@ struct RunReport {
   double total_seconds = 0;
   double peak_rss_bytes = 0;
   // The run's own stages in this call (plan, match, merge, statistics,
-  // write): wall seconds, and the process's CPU seconds over the same span,
-  // all threads, so that a stage that keeps one core busy shows.
+  // write): wall seconds, the process's CPU seconds over the same span, all
+  // threads, so that a stage that keeps one core busy shows, and the peak
+  // resident memory during the stage (since the start of the process where
+  // the system cannot reset the peak: util/memory_use.h).
   struct Stage {
     std::string name;
     double wall = 0;
     double cpu = 0;
+    double peak_rss_bytes = 0;
   };
   std::vector<Stage> stages;
 };
