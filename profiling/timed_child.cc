@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -98,9 +99,13 @@ class MemorySampler {
     stop_ = true;
     if (thread_.joinable()) thread_.join();
   }
-  // Into `u` (after Stop): the parts of the sample of the largest RSS.
+  // Into `u` (after Stop): the parts of the sample of the largest RSS, and
+  // that RSS where it is above the peak wait4 gave: a child that resets its
+  // own high-water mark (/proc/self/clear_refs, as sapmvs does to measure
+  // each group) leaves in ru_maxrss only the peak since its last reset.
   void Report(ChildUsage* u) const {
     if (samples_ == 0) return;
+    u->peak_rss_mib = std::max(u->peak_rss_mib, peak_rss_ / 1024);
     u->files_at_peak_mib = files_at_peak_ / 1024;
     u->anonymous_at_peak_mib = anonymous_at_peak_ / 1024;
   }

@@ -246,10 +246,9 @@ std::string Stages(const json& r) {
     BarChart& chart = own ? run : matching;
     if (own) {
       name = name.substr(4);
-      const double peak = Num(stage, "peak_rss_bytes");
-      if (std::isfinite(peak)) {
+      if (stage.contains("peak_rss_bytes")) {
         memory.labels.push_back(name);
-        memory.series[0].values.push_back(peak / (1 << 20));
+        memory.series[0].values.push_back(Num(stage, "peak_rss_bytes") / (1 << 20));
       }
     }
     chart.labels.push_back(name);
@@ -262,7 +261,8 @@ std::string Stages(const json& r) {
   std::string s = "<h3>The run's stages</h3>" + BarChartSvg(run);
   if (!memory.labels.empty()) {
     s += "<h3>Peak memory per stage</h3><p class=\"note\">The process's peak resident memory "
-         "while the stage ran (the match stage's is its largest group's).</p>" +
+         "while the stage ran (the match stage's is its largest group's); no bar where a stage "
+         "stayed below an earlier stage's peak.</p>" +
          BarChartSvg(memory);
   }
   if (!matching.labels.empty()) {

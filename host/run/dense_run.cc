@@ -39,6 +39,7 @@
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/log.h"
 #include "sapmvs/util/memory_use.h"
+#include "sapmvs/util/number_text.h"
 #include "sapmvs/util/output_folder.h"
 #include "sapmvs/util/progress.h"
 #include "util/run_progress.h"
@@ -110,15 +111,19 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   report.start_time = std::chrono::system_clock::now();
   auto stage_start = start;
   double stage_cpu = ProcessCpuSeconds();
-  // The match stage resets the peak for each group (below), so its own peak
-  // is the largest of theirs.
-  double groups_peak = 0;
+  // A stage's peak without resetting the high-water mark (which would make
+  // the peak that `time` or a parent's wait4 sees the last stage's): exact
+  // where the stage raised the mark, unknown (NaN) where it stayed below an
+  // earlier peak. The match stage resets it for each group (below), so its
+  // peak is the largest of theirs.
+  double groups_peak = 0, mark_before = 0;
   auto end_stage = [&](const std::string& name) {
     const double cpu = ProcessCpuSeconds();
-    report.stages.push_back(
-        {name, Since(stage_start), cpu - stage_cpu, std::max(groups_peak, PeakRssBytes())});
+    const double mark = PeakRssBytes();
+    const double peak = groups_peak > 0 ? groups_peak : mark > mark_before ? mark : kNaN;
+    report.stages.push_back({name, Since(stage_start), cpu - stage_cpu, peak});
     groups_peak = 0;
-    ResetPeakRss();
+    mark_before = mark;
     LogDetail("run: " + name + " " + Seconds(report.stages.back().wall));
     stage_start = std::chrono::steady_clock::now();
     stage_cpu = cpu;

@@ -192,11 +192,13 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   nlohmann::json matching = MatchStatsJson(report.stats, options.profile);
   nlohmann::json stages = matching["stages"];
   for (const RunReport::Stage& t : report.stages) {
-    stages.push_back({{"stage", "run " + t.name},
-                      {"wall_seconds", t.wall},
-                      {"cpu_seconds", t.cpu},
-                      {"peak_rss_bytes", t.peak_rss_bytes},
-                      {"hms", FormatHms(t.wall)}});
+    stages.push_back(
+        {{"stage", "run " + t.name},
+         {"wall_seconds", t.wall},
+         {"cpu_seconds", t.cpu},
+         {"peak_rss_bytes", std::isfinite(t.peak_rss_bytes) ? nlohmann::json(t.peak_rss_bytes)
+                                                            : nlohmann::json(nullptr)},
+         {"hms", FormatHms(t.wall)}});
   }
   j["stages"] = stages;
   j["kernels"] = matching["kernels"];

@@ -87,8 +87,9 @@ struct RunReport {
   // The run's own stages in this call (plan, match, merge, statistics,
   // write): wall seconds, the process's CPU seconds over the same span, all
   // threads, so that a stage that keeps one core busy shows, and the peak
-  // resident memory during the stage (since the start of the process where
-  // the system cannot reset the peak: util/memory_use.h).
+  // resident memory during the stage where it is known: where the stage
+  // raised the process's high-water mark, and for the match stage its
+  // largest group's; NaN where the stage stayed below an earlier peak.
   struct Stage {
     std::string name;
     double wall = 0;
