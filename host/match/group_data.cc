@@ -9,9 +9,11 @@
 
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/image_io.h"
+#include "sapmvs/match/match_group.h"
 #include "sapmvs/match/matcher_options.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
+#include "sapmvs/util/parallel_for.h"
 
 namespace sapmvs {
 
@@ -42,17 +44,28 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
   const double scale = std::ldexp(1.0, -level);
   std::vector<double> gsds;
   std::vector<cv::Mat> grey8(ids.size());
-  for (const int id : ids) {
-    const BlockImage& bi = block.images.at(id);
-    LoadedImage loaded = LoadUndistorted(bi);
-    MatchImage im;
-    im.file = FileStamp::Of(bi.path).value_or(FileStamp{});
-    im.name = bi.name;
-    im.block_index = id;
-    im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
-    const cv::Mat bgr =
-        ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
-    cv::cvtColor(bgr, grey8[group.images.size()], cv::COLOR_BGR2GRAY);
+  // kImagesReadAtOnce side by side: the plan counts that many full-resolution
+  // images (grouping.h EstimateGroupMemory).
+  std::vector<MatchImage> images(ids.size());
+  ParallelFor(
+      static_cast<long>(ids.size()),
+      [&](long k) {
+        const int id = ids[k];
+        const BlockImage& bi = block.images.at(id);
+        LoadedImage loaded = LoadUndistorted(bi);
+        MatchImage& im = images[k];
+        im.file = FileStamp::Of(bi.path).value_or(FileStamp{});
+        im.name = bi.name;
+        im.block_index = id;
+        im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
+        const cv::Mat bgr =
+            ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
+        cv::cvtColor(bgr, grey8[k], cv::COLOR_BGR2GRAY);
+      },
+      1, kImagesReadAtOnce);
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const int id = ids[k];
+    MatchImage& im = images[k];
     const bool have = geometry.images.size() > static_cast<size_t>(id) && geometry.images[id].valid;
     im.depth = have ? geometry.images[id].depth : fallback_depth;
     if (im.depth > 0) gsds.push_back(im.depth / im.camera.intrinsics().MeanFocal());

@@ -321,22 +321,24 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   // from the load on, the colour images were 3 bytes a pixel of the level
   // through the whole matching (38 MiB of Herz-Jesu-P8's 382 MiB peak), for
   // a read here that costs what the load's did (0.42 s on Herz-Jesu-P8).
-  // One image at a time, as the load reads them: each holds its
+  // kImagesReadAtOnce at a time, as the load reads them: each holds its
   // full-resolution pixels, and an undistorted copy, while it reads (the
-  // plan counts one such image). Two at a time took ODM's 4 images at
-  // level 2 from a peak of 159 to 177 MiB.
-  for (int r = 0; r < static_cast<int>(group.images.size()); ++r) {
-    if (!has_points[r]) continue;
-    const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level);
-    size_t j = 0;
-    for (size_t i = 0; i < points.size(); ++i) {
-      if (!keep[i]) continue;
-      CloudPoint& c = cloud.points[j++];
-      const DensePoint& d = points[i];
-      if (patches[d.patch].ref != r) continue;
-      c.color = ColourAt(color, d.uv);
-    }
-  }
+  // plan counts that many such images). Each point takes its colour from
+  // its reference image only, so the images' writes never meet.
+  std::vector<size_t> point_of(points.size());
+  for (size_t i = 0, j = 0; i < points.size(); ++i) point_of[i] = keep[i] ? j++ : 0;
+  ParallelFor(
+      static_cast<long>(group.images.size()),
+      [&](long r) {
+        if (!has_points[r]) return;
+        const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level);
+        for (size_t i = 0; i < points.size(); ++i) {
+          const DensePoint& d = points[i];
+          if (keep[i] && patches[d.patch].ref == r)
+            cloud.points[point_of[i]].color = ColourAt(color, d.uv);
+        }
+      },
+      1, kImagesReadAtOnce);
   stats.points = static_cast<long>(cloud.points.size());
   stats.kernels = engine.kernel_times();
   if (pmvs_pass_engine) {

@@ -425,7 +425,7 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
   const double wave = std::max(0, matcher.max_wave);
   m.device_bytes += wave * model.device_bytes_per_candidate;
   m.host_bytes += wave * model.host_bytes_per_candidate;
-  m.host_bytes += load;
+  m.host_bytes += kImagesReadAtOnce * load;
   return m;
 }
 

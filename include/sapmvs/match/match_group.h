@@ -44,6 +44,11 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const std::vector<int>& view_ids = {},
                        const GroundRegion& region = GroundRegion());
 
+// Images the load and the colours' read decode side by side (fewer on fewer
+// host threads): each is one core's work for tens of milliseconds, and each
+// holds its full-resolution pixels and an undistorted copy while it is read.
+constexpr int kImagesReadAtOnce = 2;
+
 // What matching one group holds, per unit, for the planner's memory model
 // (grouping.h EstimateGroupMemory, which spells out each term): per pixel of
 // the group's images on the device and on the host, per image cell, and per

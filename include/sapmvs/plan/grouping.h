@@ -56,9 +56,10 @@ struct GroupMemory {
 //                                             points, the filter's arrays
 //                                             (MatcherMemory says how)
 //          + M (candidate + result + 4 (V - 1))   the wave's host side
-//          + max_i 6 w_i h_i                 loading (and the colours'
-//                                             read): one full-resolution
-//                                             BGR image, raw + undistorted
+//          + R max_i 6 w_i h_i               loading (and the colours'
+//                                             read): R = kImagesReadAtOnce
+//                                             full-resolution BGR images,
+//                                             raw + undistorted
 // with V = kMaxViews and w_i h_i the full-resolution size. The per-image
 // terms grow linearly with the images and by 4x per level towards full
 // resolution; the wave is bounded by max_wave and the loading peak by the
