@@ -126,8 +126,8 @@ std::string SimulateOptions::Problem() const {
   }
   if (out.empty()) return "no output folder given (--out DIR)";
   if (!(scale > 0 && scale <= 4)) return "--scale " + std::to_string(scale) + " is outside (0, 4]";
-  if (supersampling < 2 || supersampling > 8) {
-    return "--supersampling " + std::to_string(supersampling) + " is outside 2..8";
+  if (supersampling < 1 || supersampling > 8) {
+    return "--supersampling " + std::to_string(supersampling) + " is outside 1..8";
   }
   if (!(noise >= 0 && noise <= 50))
     return "--noise " + std::to_string(noise) + " is outside 0..50 grey levels";
@@ -178,6 +178,9 @@ sim::FlightPlan PlanSimulatedFlight(const SimulateOptions& o) {
                          o.seed);
 }
 
+// Below SceneSpec's limit of 250 M cells, with room for rounding.
+constexpr double kMaxSceneCells = 2.4e8;
+
 SimulatedWorld BuildWorld(const SimulateOptions& o) {
   sim::FlightPlan plan = PlanSimulatedFlight(o);
   const sim::Preset preset = sim::FindPreset(o.preset);
@@ -185,7 +188,12 @@ SimulatedWorld BuildWorld(const SimulateOptions& o) {
   sim::SceneSpec spec = preset.scene;
   spec.width = plan.scene_width;
   spec.height = plan.scene_height;
-  spec.cell = plan.gsd * preset.cell_per_gsd;
+  // Cells of cell_per_gsd GSDs, or coarser where the scene would pass the
+  // grid's 250 M cells (a 12 MP camera, --scale 4, over more than 20
+  // images): the heights step at coarser cells, the texture, procedural,
+  // keeps its detail at the pixel.
+  spec.cell = std::max(plan.gsd * preset.cell_per_gsd,
+                       std::sqrt(spec.width * spec.height / kMaxSceneCells));
   SimulatedWorld world{sim::Scene::Generate(spec, o.seed),
                        std::move(plan),
                        {},
