@@ -35,8 +35,9 @@ echo
 echo "== sapmvs run $out/block.yaml --out $out/run"
 ./build/sapmvs run "$out/block.yaml" --out "$out/run" --restart
 echo
-echo "== sapmvs evaluate $out/run/cloud.ply --reference $out/truth/lidar.las --drop-above 2,0.5"
-./build/sapmvs evaluate "$out/run/cloud.ply" --reference "$out/truth/lidar.las" --drop-above 2,0.5
+echo "== sapmvs evaluate $out/run/cloud.ply --reference $out/truth/lidar.las --drop-above 2,0.5 --run $out/run"
+./build/sapmvs evaluate "$out/run/cloud.ply" --reference "$out/truth/lidar.las" --drop-above 2,0.5 \
+  --run "$out/run"
 echo
 echo "== sapmvs info tests/blocks/ngi.yaml"
 if [ -d ../shared/datasets/orthority_ngi_odm/ngi ]; then
