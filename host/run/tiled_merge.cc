@@ -7,6 +7,7 @@
 
 #include "sapmvs/run/seam_leveling.h"
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/parallel_for.h"
 
 namespace sapmvs {
 namespace {
@@ -147,21 +148,27 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
                (TileOf(p.position.x(), block.xmin, layout.tile_side, layout.tiles_x) == tx &&
                 TileOf(p.position.y(), block.ymin, layout.tile_side, layout.tiles_y) == ty);
       };
-      for (size_t g = 0; g < n; ++g) {
-        clouds[g] = PointCloud{};
-        if (!extent[g].Meets(reach)) continue;
-        if (whole) {
-          clouds[g] = all_read ? std::move(read[g]) : groups[g].load(PointFilter());
-        } else {
-          clouds[g] =
-              groups[g].load([&](const Eigen::Vector3d& p) { return reach.Holds(p.x(), p.y()); });
-        }
-        if (seams) {
-          for (CloudPoint& p : clouds[g].points) {
-            p.position.z() += seams->Correction(static_cast<int>(g), p.position);
-          }
-        }
-      }
+      // The groups' clouds of a tile are read side by side: reading and
+      // parsing a checkpoint is one core's work, and a tile holds all its
+      // groups' points at once whichever order they come in.
+      ParallelFor(
+          static_cast<long>(n),
+          [&](long g) {
+            clouds[g] = PointCloud{};
+            if (!extent[g].Meets(reach)) return;
+            if (whole) {
+              clouds[g] = all_read ? std::move(read[g]) : groups[g].load(PointFilter());
+            } else {
+              clouds[g] = groups[g].load(
+                  [&](const Eigen::Vector3d& p) { return reach.Holds(p.x(), p.y()); });
+            }
+            if (seams) {
+              for (CloudPoint& p : clouds[g].points) {
+                p.position.z() += seams->Correction(static_cast<int>(g), p.position);
+              }
+            }
+          },
+          1);
       MergeStats tile_stats;
       std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats);
       PointCloud tile = layout.format;
