@@ -39,7 +39,8 @@ void RegisterSimulateCommand(CLI::App& app, const GlobalFlags& global) {
                   "Images per strip (default: the preset's longest strip)");
   cmd->add_option("--exposure", o->exposure,
                   "Largest relative exposure change between images (default: the preset's)");
-  cmd->add_option("--supersampling", o->supersampling, "Rays per pixel side (2 = 2x2; 1 aliases, for timing runs of large images)")
+  cmd->add_option("--supersampling", o->supersampling,
+                  "Rays per pixel side (2 = 2x2; 1 aliases, for timing runs of large images)")
       ->capture_default_str();
   cmd->add_option("--noise", o->noise, "Sensor noise, grey levels (1 sigma)")
       ->capture_default_str();

@@ -13,6 +13,7 @@
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/byte_size.h"
 #include "sapmvs/util/error.h"
+#include "util/image_codec.h"
 
 namespace sapmvs {
 namespace {
@@ -81,29 +82,23 @@ bool ReadWorldFile(const fs::path& path, std::array<double, 6>* w) {
   return (*w)[0] != 0 && (*w)[3] != 0;
 }
 
-// Width and height from a PNG's header, 0 x 0 when it is not a PNG.
-std::array<int, 2> PngSize(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  unsigned char h[24] = {};
-  if (!in.read(reinterpret_cast<char*>(h), sizeof(h)) || h[1] != 'P' || h[2] != 'N' ||
-      h[3] != 'G') {
-    return {0, 0};
-  }
-  auto be = [&](int i) { return (h[i] << 24) | (h[i + 1] << 16) | (h[i + 2] << 8) | h[i + 3]; };
-  return {be(16), be(20)};
+// The names in a JSON array of strings, comma-separated.
+std::string Joined(const json& names) {
+  std::string out;
+  for (const json& n : names) out += (out.empty() ? "" : ", ") + n.get<std::string>();
+  return out;
 }
 
 // The groups' ground over the DSM picture, in the picture's pixels.
-std::string GroupOverlay(const json& groups, const std::array<double, 6>& w,
-                         const std::array<int, 2>& size) {
-  std::string svg = "<svg viewBox=\"0 0 " + std::to_string(size[0]) + " " +
-                    std::to_string(size[1]) +
+std::string GroupOverlay(const json& groups, const std::array<double, 6>& w, const cv::Size& size) {
+  std::string svg = "<svg viewBox=\"0 0 " + std::to_string(size.width) + " " +
+                    std::to_string(size.height) +
                     "\" preserveAspectRatio=\"none\" font-family=\"sans-serif\">";
   auto px = [&](double x, double y) {
     // Top-left pixel's centre at (w[4], w[5]); north-up, no rotation.
     return std::array<double, 2>{(x - w[4]) / w[0] + 0.5, (y - w[5]) / w[3] + 0.5};
   };
-  const double font = std::max(12.0, size[0] / 60.0);
+  const double font = std::max(12.0, size.width / 60.0);
   for (const json& g : groups) {
     const auto it = g.find("region");
     if (it == g.end() || !it->is_array() || it->size() < 3) continue;
@@ -169,8 +164,16 @@ std::string Pictures(const json& r, const fs::path& dir) {
   const fs::path dsm = dir / "dsm.png";
   if (fs::exists(dsm)) {
     std::array<double, 6> w{};
-    const std::array<int, 2> size = PngSize(dsm);
-    const bool placed = ReadWorldFile(dir / "dsm.pgw", &w) && size[0] > 0;
+    // A picture that does not decode gets no groups over it; the page says
+    // it does not decode.
+    const cv::Size size = [&] {
+      try {
+        return ReadImageFileSize(dsm);
+      } catch (const Error&) {
+        return cv::Size();
+      }
+    }();
+    const bool placed = ReadWorldFile(dir / "dsm.pgw", &w) && size.width > 0;
     s += "<figure><div class=\"map\"><img alt=\"DSM\" src=\"" + FileDataUri(dsm, "image/png") +
          "\">" + (placed ? GroupOverlay(r.value("groups", json::array()), w, size) : "") +
          "</div><figcaption>The DSM (cells of " + Decimal(Num(r, "dsm_cell"), 3) +
@@ -203,15 +206,13 @@ std::string Groups(const json& r) {
   BarChart memory{" MiB", {}, {{"estimate", kOrange, {}}, {"measured peak", kBlue, {}}}, 0};
   for (const json& g : groups) {
     const json images = g.value("images", json::array());
-    std::string names;
-    for (const json& n : images) names += (names.empty() ? "" : ", ") + n.get<std::string>();
     const double estimate = Num(g.value("memory_estimate_bytes", json::object()), "total");
     const double peak = Num(g.value("memory_measured_bytes", json::object()), "peak_rss");
     const std::string label = "group " + std::to_string(g.value("group", 0));
     s += "<tr>" + Cell(std::to_string(g.value("group", 0))) + Cell(std::to_string(images.size())) +
          Cell(GroupedInteger(Num(g, "points"))) + Cell(GroupedInteger(Num(g, "kept_after_merge"))) +
          Cell(Decimal(Num(g, "seconds"), 1)) + Cell(MaybeBytes(estimate)) + Cell(MaybeBytes(peak)) +
-         Cell(HtmlEscape(names), true) + "</tr>";
+         Cell(HtmlEscape(Joined(images)), true) + "</tr>";
     time.labels.push_back(label);
     time.series[0].values.push_back(Num(g, "seconds"));
     memory.labels.push_back(label);
@@ -221,9 +222,7 @@ std::string Groups(const json& r) {
   s += "</table>";
   const json ungrouped = r.value("ungrouped", json::array());
   if (!ungrouped.empty()) {
-    std::string names;
-    for (const json& n : ungrouped) names += (names.empty() ? "" : ", ") + n.get<std::string>();
-    s += "<p class=\"note\">In no group: " + HtmlEscape(names) + ".</p>";
+    s += "<p class=\"note\">In no group: " + HtmlEscape(Joined(ungrouped)) + ".</p>";
   }
   s += "<h3>Time per group</h3>" + BarChartSvg(time);
   s += "<h3>Memory per group</h3><p class=\"note\">The plan's estimate, and the process's peak "

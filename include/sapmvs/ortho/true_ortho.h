@@ -11,8 +11,9 @@
 // Objects (steep DSM cells, ortho_surface.h) are each taken, wherever it
 // sees them, from the image that looks most directly at their centre, so
 // that the seams where the chosen image changes run over open ground;
-// across a seam the colours are blended over a few cells. Narrow gaps no image sees are inpainted
-// from around them; wider ones, and cells without a DSM height, stay empty (alpha 0).
+// across a seam the colours are blended over a few cells. Narrow gaps no
+// image sees are inpainted from around them; wider ones, and cells without a
+// DSM height, stay empty (alpha 0).
 
 #include <cstdint>
 #include <functional>
