@@ -252,11 +252,11 @@ TEST_F(CliRunTest, MemoryEstimateHoldsAndABudgetSplitsTheBlock) {
   ASSERT_EQ(whole.at("groups").size(), 1u);
   check_groups(whole);
 
-  // A budget between what a group of 2 and a group of 4 need, at level 0:
-  // at level 1 an image of this block adds only about 2 MiB to an estimate,
-  // less than the process's RSS drifts between two runs (up to 7 MiB, which
-  // every estimate includes), at level 0 about 8 MiB: the budget lies at
-  // least 7 MiB from either group's estimate. Two groups of 2 (one
+  // A budget between what a group of 2 and a group of 4 need, at level 0
+  // (at level 1 an image of this block adds only about 1.4 MiB to an
+  // estimate, at level 0 about 5.5 MiB): the budget lies at least 5 MiB
+  // from either group's estimate, where the process's RSS, which every
+  // estimate includes, drifts by 0.2 MiB between runs. Two groups of 2 (one
   // per strip, --min-image-num 2), with what views still fit.
   const fs::path whole_out = *root_ / "budget_whole";  // not among the split run's files
   const auto whole_l0 = RunCli("run " + Block().string() + " --out " + whole_out.string() +
@@ -277,9 +277,9 @@ TEST_F(CliRunTest, MemoryEstimateHoldsAndABudgetSplitsTheBlock) {
   std::ifstream two_in(two_json);
   const nlohmann::json two_plan = nlohmann::json::parse(two_in);
   const auto& two = two_plan.at("groups").at(0).at("memory");
-  const double four_adds = estimate.at("device").get<double>() + estimate.at("host").get<double>();
-  const double two_adds = two.at("device_bytes").get<double>() + two.at("host_bytes").get<double>();
-  ASSERT_GT(four_adds - two_adds, 14.0 * (1 << 20)) << "two images at level 0 add too little";
+  const double four_adds = estimate.at("host").get<double>();
+  const double two_adds = two.at("host_bytes").get<double>();
+  ASSERT_GT(four_adds - two_adds, 10.0 * (1 << 20)) << "two images at level 0 add too little";
   const double budget = estimate.at("total").get<double>() - 0.5 * (four_adds - two_adds);
   const auto split = RunCli("run " + Block().string() + " --out " + out_.string() +
                             " --level 0 --min-image-num 2 -q --memory-budget " +

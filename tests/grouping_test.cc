@@ -168,23 +168,63 @@ TEST(GroupingStrips, StripViewsComeFromTheNeighbouringStrips) {
     EXPECT_GE(span(g, g.MatchedIn()), 20);
 }
 
-// A view-only image counts in the memory budget: under a budget that holds 6
-// of campus's (equal) images, a run of 6 takes no views and a shorter one
-// fills up to 6.
+// A view-only image counts in the memory budget, though less than an image
+// of the group (it takes no points): under a budget that holds 6 of campus's
+// (equal) images, a run of 6 takes no views, and a shorter one takes views
+// until one more would not fit.
 TEST(GroupingStrips, StripViewsStayWithinTheBudget) {
   const SimBlock s = MakeSimBlock("campus");
   GroupingOptions o = StripOptions();
-  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3, 4, 5}, 1).Total() + 1;
-  const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
-  for (const ImageGroup& g : plan.groups) {
-    EXPECT_EQ(g.views.size(), std::min<size_t>(2, 6 - g.images.size()));
-    EXPECT_LE(g.memory.Total(), o.memory_budget);
+  for (const int fit : {6, 7}) {
+    std::vector<int> ids(fit);
+    std::iota(ids.begin(), ids.end(), 0);
+    o.memory_budget = EstimateGroupMemory(s.block, ids, 1).Total() + 1;
+    int short_runs_with_views = 0;
+    for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups) {
+      EXPECT_LE(g.memory.Total(), o.memory_budget);
+      if (static_cast<int>(g.images.size()) == fit) {
+        EXPECT_TRUE(g.views.empty());
+      }
+      if (static_cast<int>(g.images.size()) >= fit) continue;
+      short_runs_with_views += !g.views.empty();
+      if (g.views.size() >= 2) continue;
+      // One more view (any image of the block, all of campus's being the
+      // same size) would not have fitted.
+      std::vector<int> with = g.MatchedIn();
+      with.push_back(with.front());
+      std::vector<double> shares(g.images.size(), 1.0);
+      shares.resize(with.size(), 0.0);
+      MatcherOptions level1;
+      level1.level = 1;
+      EXPECT_GT(EstimateGroupMemory(s.block, with, level1, shares).Total() + g.memory.process_bytes,
+                o.memory_budget);
+    }
+    EXPECT_GT(short_runs_with_views, 0) << "budget for " << fit << " images";
   }
-  o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3, 4, 5, 6}, 1).Total() + 1;
-  for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups) {
-    EXPECT_EQ(g.views.size(), std::min<size_t>(2, 7 - g.images.size()));
-    EXPECT_LE(g.memory.Total(), o.memory_budget);
-  }
+}
+
+// A view costs its pixels but no cells; an image of a footprint group only
+// the cells it sees of the tile (cell_shares).
+TEST(GroupingMemory, ViewsAndGroundOutsideTheTileTakeNoPoints) {
+  const SimBlock s = MakeSimBlock("campus");
+  MatcherOptions m;
+  const GroupMemory refs = EstimateGroupMemory(s.block, {0, 1}, m);
+  EXPECT_DOUBLE_EQ(EstimateGroupMemory(s.block, {0, 1}, m, {1.0, 1.0}).host_bytes, refs.host_bytes);
+  const GroupMemory view = EstimateGroupMemory(s.block, {0, 1}, m, {1.0, 0.0});
+  const GroupMemory half = EstimateGroupMemory(s.block, {0, 1}, m, {1.0, 0.5});
+  EXPECT_LT(view.host_bytes, refs.host_bytes);
+  EXPECT_DOUBLE_EQ(half.host_bytes - view.host_bytes, 0.5 * (refs.host_bytes - view.host_bytes));
+  // 486 x 324 pixels at level 1.
+  EXPECT_DOUBLE_EQ(refs.host_bytes - view.host_bytes,
+                   MatcherMemory().host_bytes_per_point_pixel * 486 * 324);
+  // The device holds a view's grey as it holds any image's.
+  EXPECT_DOUBLE_EQ(view.device_bytes, refs.device_bytes);
+  // What the budget bounds is the process: the device's own memory apart.
+  EXPECT_DOUBLE_EQ(refs.Total(), refs.host_bytes + refs.process_bytes);
+  EXPECT_THROW(EstimateGroupMemory(s.block, {0, 1}, m, {1.0}), Error);
+  EXPECT_THROW(EstimateGroupMemory(s.block, {0, 1}, m, {1.0, 1.5}), Error);
+  EXPECT_THROW(EstimateGroupMemory(s.block, {0, 1}, m, {1.0, -0.1}), Error);
+  EXPECT_THROW(EstimateGroupMemory(s.block, {0, 1}, m, {1.0, std::nan("")}), Error);
 }
 
 // `run` matches what PlanGroups returns; a block that fits one group is not
@@ -440,24 +480,32 @@ TEST(GroupingFootprint, GroupsRespectMaxImagesAndTheBudget) {
   const SimBlock s = MakeSimBlock("campus");
   GroupingOptions o = StripOptions();
   o.strategy = GroupingStrategy::kFootprint;
-  o.max_images = 5;
-  o.tile_views = 5;
-  // Room for 3 images of the block, not 4.
+  o.max_images = 8;
+  o.tile_views = 8;
+  // Room for 3 images of the block that take points on their whole
+  // footprints, not 4; a footprint group's images take them on its tile only.
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2}, MatcherOptions{}).Total() + 1;
   ASSERT_GT(EstimateGroupMemory(s.block, {0, 1, 2, 3}, MatcherOptions{}).Total(), o.memory_budget);
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   ASSERT_FALSE(plan.groups.empty());
+  size_t largest = 0;
   for (const ImageGroup& g : plan.groups) {
+    largest = std::max(largest, g.images.size());
     EXPECT_GE(g.images.size(), 2u);
-    EXPECT_LE(g.images.size(), 3u);
     EXPECT_LE(g.memory.Total(), o.memory_budget);
     EXPECT_EQ(g.strip, -1);
     EXPECT_TRUE((g.center.array() > g.tile_min.array()).all());
     EXPECT_TRUE((g.center.array() < g.tile_max.array()).all());
   }
+  EXPECT_GT(largest, 3u);
+  // The budget still binds: without it, groups are larger.
   o.memory_budget = 8.0 * (1ull << 30);
-  for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups)
-    EXPECT_LE(g.images.size(), 5u);
+  size_t unbound = 0;
+  for (const ImageGroup& g : PlanGroups(s.block, o, MatcherOptions{}).groups) {
+    EXPECT_LE(g.images.size(), 8u);
+    unbound = std::max(unbound, g.images.size());
+  }
+  EXPECT_GT(unbound, largest);
 }
 
 TEST(GroupingFootprint, ExtraViewsSeeTheTileAndAreNoneOfItsImages) {
@@ -602,9 +650,14 @@ TEST(GroupingMemory, TheProcessCountsInEveryGroupAndInTheBudget) {
             (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
   for (const ImageGroup& g : with.groups) {
     EXPECT_EQ(g.memory.process_bytes, counted);
-    // View-only images are loaded too.
+    // View-only images are loaded too, but take no points: strip groups'
+    // images take them over their whole footprints.
+    std::vector<double> shares(g.images.size(), 1.0);
+    shares.resize(g.MatchedIn().size(), 0.0);
+    MatcherOptions level1;
+    level1.level = 1;
     EXPECT_DOUBLE_EQ(g.memory.Total(),
-                     EstimateGroupMemory(s.block, g.MatchedIn(), 1).Total() + counted);
+                     EstimateGroupMemory(s.block, g.MatchedIn(), level1, shares).Total() + counted);
     EXPECT_LE(g.memory.Total(), o.memory_budget);
   }
   // Without the process in the budget the groups would not have fitted.

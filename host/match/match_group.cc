@@ -63,13 +63,17 @@ MatcherMemoryModel MatcherMemory() {
   // grouping.h EstimateGroupMemory spells out each term.
   m.device_bytes_per_pixel = sizeof(float);
   m.host_bytes_per_pixel = sizeof(float) + 1;
-  // Fitted, not summed: the patches and points a cell ends up with, and the
-  // filter's arrays over them, depend on how much of the images matches.
-  // With 72 bytes a cell (27 bytes a pixel in all), every group of the
-  // five presets is estimated 14 to 21 % above its measured peak, and
-  // Herz-Jesu-P8's 45 to 54 % (profiling/results/memory.md, "Colours read
-  // at the end").
-  m.host_bytes_per_cell = 72;
+  // Fitted, not summed: the patches and points a pixel ends up with, and
+  // the filter's arrays over them, depend on how much of the images matches
+  // (0.007 to 0.17 points a pixel on the blocks below). Counted on the
+  // pixels that can take points only (EstimateGroupMemory's cell_shares:
+  // not a view's, not outside a footprint group's tile), and per pixel, not
+  // per cell, as points are emitted per pixel: 13 bytes put every group of
+  // `small`, `city`, `campus`, Herz-Jesu-P8, the Caliterra flight and
+  // simulated 12 MP flights of 20 and 60 images within -12 to +12 % of its
+  // measured peak, and `tiny` at level 0 with cells of 2 and of 1 pixel
+  // within -10 to -5 % (profiling/results/memory.md).
+  m.host_bytes_per_point_pixel = 13;
   m.device_bytes_per_candidate = batch.per_patch + views * batch.per_pair;
   m.host_bytes_per_candidate =
       sizeof(PatchCandidate) + sizeof(std::optional<AcceptedPatch>) + 4 * views;

@@ -6,6 +6,27 @@
 
 namespace sapmvs {
 
+namespace {
+
+// Share of footprint f's 7 x 7 samples (SelectViews counts views so) for
+// which `inside` holds.
+template <typename Inside>
+double SampledShare(const Footprint& f, const Inside& inside) {
+  constexpr int kGrid = 7;
+  int count = 0;
+  for (int gy = 0; gy < kGrid; ++gy) {
+    for (int gx = 0; gx < kGrid; ++gx) {
+      const double u = (gx + 0.5) / kGrid, v = (gy + 0.5) / kGrid;
+      const auto& c = f.corners;
+      count += inside(
+          Eigen::Vector2d((1 - v) * ((1 - u) * c[0] + u * c[1]) + v * ((1 - u) * c[3] + u * c[2])));
+    }
+  }
+  return static_cast<double>(count) / (kGrid * kGrid);
+}
+
+}  // namespace
+
 std::vector<Footprint> Footprints(const Block& block, const BlockGeometry& geometry) {
   std::vector<Footprint> out(block.images.size());
   for (size_t i = 0; i < out.size(); ++i) {
@@ -38,8 +59,38 @@ GroupMemory EstimateInProcess(const Block& block, const std::vector<int>& ids,
   return mem;
 }
 
+std::vector<double> CellShares(const ImageGroup& g, const std::vector<Footprint>& fp) {
+  const bool tiled = (g.tile_max.array() > g.tile_min.array()).all();
+  std::vector<double> shares;
+  for (const int i : g.images) {
+    if (!tiled || !fp[i].valid) {
+      shares.push_back(1.0);
+      continue;
+    }
+    shares.push_back(SampledShare(fp[i], [&](const Eigen::Vector2d& p) {
+      return (p.array() >= g.tile_min.array()).all() && (p.array() <= g.tile_max.array()).all();
+    }));
+  }
+  shares.resize(shares.size() + g.views.size(), 0.0);
+  return shares;
+}
+
+GroupMemory EstimateInProcess(const Block& block, const ImageGroup& g,
+                              const std::vector<Footprint>& fp, const MatcherOptions& matcher,
+                              double process_bytes) {
+  GroupMemory mem = EstimateGroupMemory(block, g.MatchedIn(), matcher, CellShares(g, fp));
+  mem.process_bytes = process_bytes;
+  return mem;
+}
+
 bool Fits(const Block& block, const std::vector<int>& ids, const GroupingPlan& plan) {
   return EstimateInProcess(block, ids, plan.matcher, plan.process_bytes).Total() <=
+         plan.options.memory_budget;
+}
+
+bool Fits(const Block& block, const ImageGroup& g, const std::vector<Footprint>& fp,
+          const GroupingPlan& plan) {
+  return EstimateInProcess(block, g, fp, plan.matcher, plan.process_bytes).Total() <=
          plan.options.memory_budget;
 }
 
@@ -51,18 +102,7 @@ Eigen::Vector2d MeanCenter(const std::vector<Footprint>& fp, const std::vector<i
 
 double OverlapShare(const std::vector<Footprint>& fp, int i, int j) {
   if (!fp[i].valid || !fp[j].valid) return 1.0;
-  constexpr int kGrid = 7;
-  int inside = 0;
-  for (int gy = 0; gy < kGrid; ++gy) {
-    for (int gx = 0; gx < kGrid; ++gx) {
-      const double u = (gx + 0.5) / kGrid, v = (gy + 0.5) / kGrid;
-      const auto& c = fp[i].corners;
-      const Eigen::Vector2d p =
-          (1 - v) * ((1 - u) * c[0] + u * c[1]) + v * ((1 - u) * c[3] + u * c[2]);
-      inside += fp[j].Contains(p);
-    }
-  }
-  return static_cast<double>(inside) / (kGrid * kGrid);
+  return SampledShare(fp[i], [&](const Eigen::Vector2d& p) { return fp[j].Contains(p); });
 }
 
 std::vector<int> ShortOfViews(const std::vector<Footprint>& fp, const std::vector<int>& ids,

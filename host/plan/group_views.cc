@@ -50,15 +50,12 @@ void AddStripViews(const Block& block, const GroupingOptions& o, const std::vect
     std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
       return a.first != b.first ? a.first > b.first : a.second < b.second;
     });
-    std::vector<int> with = g.MatchedIn();
     int added = 0;
     for (const auto& [share, j] : ranked) {
       if (added >= o.strip_views) break;
-      with.push_back(j);
-      if (!Fits(block, with, *plan)) {
-        with.pop_back();
-        break;
-      }
+      ImageGroup with = g;
+      with.views.push_back(j);
+      if (!Fits(block, with, fp, *plan)) break;
       g.views.push_back(j);
       ++added;
     }
@@ -87,10 +84,10 @@ std::vector<int> JoinBestGroup(const Block& block, const std::vector<Footprint>&
     if (std::any_of(plan->groups.begin(), plan->groups.end(),
                     [&](const ImageGroup& g) { return Holds(g, i); }))
       continue;
-    auto fits_with = [&](const ImageGroup& g) {
-      std::vector<int> with = g.MatchedIn();
-      with.push_back(i);
-      return Fits(block, with, *plan);
+    auto fits_with = [&](const ImageGroup& g, bool as_view) {
+      ImageGroup with = g;
+      (as_view ? with.views : with.images).push_back(i);
+      return Fits(block, with, fp, *plan);
     };
     // As an image in the group that sees most of it and has room; else as a
     // view of the one that sees most of it.
@@ -98,7 +95,7 @@ std::vector<int> JoinBestGroup(const Block& block, const std::vector<Footprint>&
     for (const size_t gi : order) {
       ImageGroup& g = plan->groups[gi];
       if (!as_image[k] || key[gi].first >= 0 ||
-          static_cast<int>(g.images.size()) >= plan->options.max_images || !fits_with(g))
+          static_cast<int>(g.images.size()) >= plan->options.max_images || !fits_with(g, false))
         continue;
       g.images.push_back(i);
       if (g.strip >= 0) g.center = MeanCenter(fp, g.images);
@@ -107,7 +104,7 @@ std::vector<int> JoinBestGroup(const Block& block, const std::vector<Footprint>&
     }
     for (size_t o = 0; o < order.size() && !joined; ++o) {
       ImageGroup& g = plan->groups[order[o]];
-      if (!fits_with(g)) continue;
+      if (!fits_with(g, true)) continue;
       g.views.push_back(i);
       joined = true;
     }
@@ -172,8 +169,10 @@ void AddAngleViews(const Block& block, const std::vector<Footprint>& fp, Groupin
         }
       }
       if (best < 0) break;
+      ImageGroup with = g;
+      with.views.push_back(best);
+      if (!Fits(block, with, fp, *plan)) break;
       matched.push_back(best);
-      if (!Fits(block, matched, *plan)) break;
       g.views.push_back(best);
       span = best_span;
     }

@@ -58,8 +58,7 @@ void CheckSmallestGroupFits(const Block& block, const GroupingOptions& o, const 
         "memory budget " + FormatBytes(o.memory_budget) + " is too small: " + std::to_string(k) +
         " images, the fewest a group can match (min_image_num " + std::to_string(m.min_image_num) +
         "), need " + FormatBytes(mem.Total()) + " at level " + std::to_string(m.level) + " (" +
-        GroupNames(block, ids) + ": device " + FormatBytes(mem.device_bytes) + " + host " +
-        FormatBytes(mem.host_bytes) +
+        GroupNames(block, ids) + ": " + FormatBytes(mem.host_bytes) +
         (process_bytes > 0 ? " + the process before matching " + FormatBytes(process_bytes)
                            : std::string()) +
         "); raise the budget or match at a coarser level");
@@ -306,6 +305,8 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
       // image that sees more of the tile, then to the more nadir one. The
       // view-only images follow by the same rule.
       ImageGroup g;
+      g.tile_min = t0;
+      g.tile_max = t0 + tile;
       const int target = std::min(o.tile_views, o.max_images);
       const std::vector<int> available = views;
       std::fill(views.begin(), views.end(), 0);
@@ -324,9 +325,9 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
             const std::tuple<int, int, size_t, double> key{second, gain, candidates[c].seen.size(),
                                                            candidates[c].nadir};
             if (gain > 0 && (best < 0 || key > best_key)) {
-              std::vector<int> with = g.MatchedIn();
-              with.push_back(candidates[c].image);
-              if (!Fits(block, with, *plan)) continue;
+              ImageGroup with = g;
+              (into == &g.images ? with.images : with.views).push_back(candidates[c].image);
+              if (!Fits(block, with, fp, *plan)) continue;
               best = static_cast<int>(c);
               best_key = key;
             }
@@ -352,6 +353,11 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
         std::sort(other.begin(), other.end());
         if (other != key_images) continue;
         ImageGroup& e = plan->groups[k];
+        // Its images then take points on both tiles.
+        ImageGroup both = e;
+        both.tile_min = e.tile_min.cwiseMin(t0);
+        both.tile_max = e.tile_max.cwiseMax(t0 + tile);
+        if (!Fits(block, both, fp, *plan)) continue;
         const double n = static_cast<double>(tiles_in_group[k]);
         e.center = (e.center * n + center) / (n + 1);
         e.tile_min = e.tile_min.cwiseMin(t0);
@@ -403,28 +409,35 @@ GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& imag
 }
 
 GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images,
-                                const MatcherOptions& matcher) {
+                                const MatcherOptions& matcher,
+                                const std::vector<double>& cell_shares) {
   if (matcher.level < 0 || matcher.level > kMaxLevel)
     throw Error("memory estimate: level in 0.." + std::to_string(kMaxLevel) + " expected, got " +
                 std::to_string(matcher.level));
+  if (!cell_shares.empty() && cell_shares.size() != images.size())
+    throw Error("memory estimate: " + std::to_string(images.size()) +
+                " cell shares expected, got " + std::to_string(cell_shares.size()));
   const MatcherMemoryModel model = MatcherMemory();
-  const double cs = std::max(1, matcher.cell_size);
   GroupMemory m;
   double load = 0;
-  for (const int id : images) {
+  for (size_t k = 0; k < images.size(); ++k) {
+    const int id = images[k];
     if (id < 0 || id >= static_cast<int>(block.images.size()))
       throw Error("memory estimate: image index " + std::to_string(id) + " is outside the block");
+    const double share = cell_shares.empty() ? 1.0 : cell_shares[k];
+    if (!(share >= 0 && share <= 1))
+      throw Error("memory estimate: a cell share in [0, 1] expected, got " + std::to_string(share));
     const Camera& cam = block.images[id].camera;
-    const Intrinsics k = cam.intrinsics().Scaled(std::ldexp(1.0, -matcher.level));
-    const double pixels = static_cast<double>(k.width) * k.height;
-    const double cells = std::ceil(k.width / cs) * std::ceil(k.height / cs);
+    const Intrinsics in = cam.intrinsics().Scaled(std::ldexp(1.0, -matcher.level));
+    const double pixels = static_cast<double>(in.width) * in.height;
     m.device_bytes += model.device_bytes_per_pixel * pixels;
-    m.host_bytes += model.host_bytes_per_pixel * pixels + model.host_bytes_per_cell * cells;
+    m.host_bytes +=
+        (model.host_bytes_per_pixel + model.host_bytes_per_point_pixel * share) * pixels;
     load = std::max(load, 6.0 * cam.width() * cam.height());
   }
   const double wave = std::max(0, matcher.max_wave);
   m.device_bytes += wave * model.device_bytes_per_candidate;
-  m.host_bytes += wave * model.host_bytes_per_candidate;
+  m.host_bytes += wave * (model.host_bytes_per_candidate + model.device_bytes_per_candidate);
   m.host_bytes += kImagesReadAtOnce * load;
   return m;
 }
@@ -490,7 +503,7 @@ GroupingPlan PlanGroups(const Block& block, const GroupingOptions& options,
   AddAngleViews(block, fp, &plan);
   for (ImageGroup& g : plan.groups) {
     const std::vector<int> matched_in = g.MatchedIn();
-    g.memory = EstimateInProcess(block, matched_in, matcher, process_bytes);
+    g.memory = EstimateInProcess(block, g, fp, matcher, process_bytes);
     g.short_of_views = ShortOfViews(fp, g.images, matcher.min_image_num, matched_in);
   }
   return plan;

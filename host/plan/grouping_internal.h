@@ -43,11 +43,25 @@ std::vector<Footprint> Footprints(const Block& block, const BlockGeometry& geome
 std::string Fixed(double v, int precision);
 
 // A group's estimate with the process around it (PlanGroups' process_bytes),
-// which is what memory_budget bounds.
+// which is what memory_budget bounds: `ids` all references of their whole
+// footprints (a strip run, the block as one group).
 GroupMemory EstimateInProcess(const Block& block, const std::vector<int>& ids,
                               const MatcherOptions& matcher, double process_bytes);
+// The same for `g`, whose views take no points and whose images, when it has
+// a tile, take them only where they see it (CellShares).
+GroupMemory EstimateInProcess(const Block& block, const ImageGroup& g,
+                              const std::vector<Footprint>& fp, const MatcherOptions& matcher,
+                              double process_bytes);
+// Per image of g.MatchedIn(), the share of its cells that can take points
+// (EstimateGroupMemory's cell_shares): a footprint group matches its tile
+// and the merge keeps what it matched there, so each image takes points
+// where its footprint (7 x 7 samples) lies in the tile, and 1 without a
+// tile or a footprint; a view, never a reference, 0.
+std::vector<double> CellShares(const ImageGroup& g, const std::vector<Footprint>& fp);
 // The plan's options and matcher say what a group may use.
 bool Fits(const Block& block, const std::vector<int>& ids, const GroupingPlan& plan);
+bool Fits(const Block& block, const ImageGroup& g, const std::vector<Footprint>& fp,
+          const GroupingPlan& plan);
 
 Eigen::Vector2d MeanCenter(const std::vector<Footprint>& fp, const std::vector<int>& ids);
 

@@ -117,7 +117,7 @@ void PrintPlan(const Block& block, const GroupingPlan& plan, std::ostream& out) 
     for (const int i : plan.ungrouped) out << " " << (i + 1) << " " << block.images[i].name;
     out << "\n";
   }
-  out << "largest     " << FormatBytes(largest) << " (device + host";
+  out << "largest     " << FormatBytes(largest) << " (host";
   if (plan.process_bytes > 0) out << " + the process's " << FormatBytes(plan.process_bytes);
   out << ") of " << FormatBytes(o.memory_budget) << "; centres in the local frame, origin "
       << Fixed(block.origin.x(), 3) << " " << Fixed(block.origin.y(), 3) << "\n";

@@ -51,12 +51,13 @@ constexpr int kImagesReadAtOnce = 2;
 
 // What matching one group holds, per unit, for the planner's memory model
 // (grouping.h EstimateGroupMemory, which spells out each term): per pixel of
-// the group's images on the device and on the host, per image cell, and per
-// candidate of a wave on both sides, with kMaxViews - 1 views to a patch.
+// the group's images on the device and on the host, per pixel that can take
+// points, and per candidate of a wave on both sides, with kMaxViews - 1
+// views to a patch.
 struct MatcherMemoryModel {
   double device_bytes_per_pixel = 0;
   double host_bytes_per_pixel = 0;
-  double host_bytes_per_cell = 0;
+  double host_bytes_per_point_pixel = 0;  // per pixel that can take points
   double device_bytes_per_candidate = 0;
   double host_bytes_per_candidate = 0;
   // What the process gains once, in its first group, and keeps: the kernels

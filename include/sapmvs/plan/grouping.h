@@ -27,35 +27,41 @@ namespace sapmvs {
 struct BlockGeometry;
 
 struct GroupMemory {
+  // The device's own memory: what a GPU must hold. A device that shares the
+  // host's memory (PoCL's CPU device) reads the host's grey in place and
+  // holds only the wave's buffers, which `host_bytes` counts too.
   double device_bytes = 0;
   double host_bytes = 0;
   // The process before the group: the program and its libraries, the OpenCL
-  // runtime, the block (GroupingPlan::process_bytes). Matching adds the
-  // other two terms to it, so their sum is what the process peaks at.
+  // runtime, the block (GroupingPlan::process_bytes). Matching adds
+  // host_bytes to it, so their sum is what the process peaks at.
   double process_bytes = 0;
-  double Total() const { return device_bytes + host_bytes + process_bytes; }
+  // The process's peak while it matches the group: what memory_budget
+  // bounds, and what the run measures (report.json memory_measured_bytes).
+  double Total() const { return host_bytes + process_bytes; }
 };
 
 // Memory to match `images` of `block` at `level`, in bytes. With, for image
 // i, P_i its pixels at the level (sides halved per level as
-// Intrinsics::Scaled rounds them) and C_i = ceil(w/c) ceil(h/c) its cells
-// (c = MatcherOptions::cell_size, 2 by default), and M = max_wave:
+// Intrinsics::Scaled rounds them), s_i the share of them that can take
+// points (`cell_shares`: 1 for a group that owns all its images' ground,
+// the share of the footprint within its tile for a footprint group's image,
+// 0 for a view, which is never a reference; all 1 when empty), and
+// M = max_wave:
 //   device = sum_i 4 P_i                      float32 grey, resident for the
-//                                             group (a device that shares
-//                                             the host's memory reads the
-//                                             host's copy; counted anyway)
-//          + M (48 + 48 + 4 + 16 (V - 1))     one wave: NccPatch, refined
+//                                             group
+//          + W = M (48 + 48 + 4 + 16 (V - 1)) one wave: NccPatch, refined
 //                                             patch, view offset, and per
 //                                             view a pair, an index, a score
-//   host   = sum_i (5 P_i + 72 C_i)           float32 grey + edge mask
+//   host   = sum_i (5 + 13 s_i) P_i           float32 grey + edge mask
 //                                             (colours are read again at
-//                                             the end), and per cell 72
-//                                             bytes, fitted to the measured
-//                                             peaks: the cell grids, the
-//                                             accepted patches and dense
-//                                             points, the filter's arrays
-//                                             (MatcherMemory says how)
-//          + M (candidate + result + 4 (V - 1))   the wave's host side
+//                                             the end), and per pixel that
+//                                             can take points 13 bytes,
+//                                             fitted to the measured peaks:
+//                                             the cell grids, the accepted
+//                                             patches and dense points, the
+//                                             filter's arrays (MatcherMemory)
+//          + W + M (candidate + result + 4 (V - 1))   the wave, both sides
 //          + R max_i 6 w_i h_i               loading (and the colours'
 //                                             read): R = kImagesReadAtOnce
 //                                             full-resolution BGR images,
@@ -64,11 +70,13 @@ struct GroupMemory {
 // terms grow linearly with the images and by 4x per level towards full
 // resolution; the wave is bounded by max_wave and the loading peak by the
 // largest image, whatever the group. Throws Error for an index outside the
-// block or a level outside 0..6.
+// block, a level outside 0..6, or cell_shares of another size than images
+// or outside [0, 1].
 GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images, int level);
-// The same for the cell size, wave size and level of `matcher`.
+// The same for the wave size and level of `matcher`.
 GroupMemory EstimateGroupMemory(const Block& block, const std::vector<int>& images,
-                                const MatcherOptions& matcher);
+                                const MatcherOptions& matcher,
+                                const std::vector<double>& cell_shares = {});
 
 struct ImageGroup {
   std::vector<int> images;  // indices into block.images, in flight order (strip)

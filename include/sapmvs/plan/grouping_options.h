@@ -31,7 +31,9 @@ struct GroupingOptions {
   // covered 96.1 % in 109 s (PMVS2 96.3 %, 552 s): a point at a tile's
   // fringe or on a tree's rim needs more references than views.
   int max_images = 8;
-  // Bytes that the device + host estimate of one group must fit in.
+  // Bytes the process's estimated peak while it matches one group must fit
+  // in (GroupMemory::Total: what it held before, and the group's host side).
+  // A GPU's own memory is the device estimate, which this does not bound.
   double memory_budget = 8.0 * (1ull << 30);
   // Footprint strategy: tile side as a share of the median image footprint's
   // shorter side on the ground, (0, 4]. Smaller tiles give more groups, each
@@ -80,7 +82,7 @@ void VisitFields(GroupingOptions& o, F&& f) {
         .Unit("bytes")
         .Range(Above(0))
         .Style(FlagStyle::kByteSize)
-        .Help("Device + host memory one group may use: bytes, or 512M, 8G, 1.5G"));
+        .Help("Memory the process may use while it matches one group: bytes, or 512M, 8G, 1.5G"));
   f(Field(o.tile_size, "tile_size")
         .Flag("--tile-size")
         .In(s)
