@@ -171,7 +171,7 @@ std::vector<unsigned char> EncodeImage(const cv::Mat& image, ImageEncoding encod
   return Gdal().encode_image(image, encoding, what, jpeg_quality);
 }
 bool CanEncode(ImageEncoding encoding) { return Gdal().can_encode(encoding); }
-Dem Dem::Load(const fs::path& path) { return Gdal().load_dem(path); }
+Dem Dem::Load(const fs::path& path, long max_cells) { return Gdal().load_dem(path, max_cells); }
 std::unique_ptr<EcefToUtm> MakeEcefToUtm(int epsg) { return Gdal().make_ecef_to_utm(epsg); }
 void WriteGeoTiff(const fs::path& path, const GeoRaster& raster) {
   Gdal().write_geotiff(path, raster);

@@ -34,7 +34,7 @@ struct GdalModuleFunctions {
   std::vector<unsigned char> (*encode_image)(const cv::Mat&, ImageEncoding, const std::string&,
                                              int);
   bool (*can_encode)(ImageEncoding);
-  Dem (*load_dem)(const std::filesystem::path&);
+  Dem (*load_dem)(const std::filesystem::path&, long);
   std::unique_ptr<EcefToUtm> (*make_ecef_to_utm)(int);
   void (*write_geotiff)(const std::filesystem::path&, const GeoRaster&);
   void (*write_color_geotiff)(const std::filesystem::path&, const GeoRaster&,
@@ -48,7 +48,7 @@ struct GdalModuleFunctions {
                                     const std::filesystem::path&, const DsmPictureOptions&);
 };
 
-constexpr int kGdalModuleVersion = 1;
+constexpr int kGdalModuleVersion = 2;
 
 // The argument that makes the binary a CRS checker (GeoOutputsCheck in
 // gdal_module.cc): `sapmvs --internal-check-crs CRS` loads the module, checks

@@ -264,8 +264,12 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
   const double side = o.tile_size * sides[sides.size() / 2];
   const Eigen::Vector2d size = hi - lo;
   CheckTileCost(block, o, valid, size / side);
-  const int nx = std::max(1, static_cast<int>(std::ceil(size.x() / side - 1e-9)));
-  const int ny = std::max(1, static_cast<int>(std::ceil(size.y() / side - 1e-9)));
+  // Tiles up to 2 % longer than `side` rather than one more: a regular
+  // flight's extent is close to a whole number of footprints, and a
+  // centimetre of ground height either way (a DEM read at another cell)
+  // would otherwise add or drop a row of tiles.
+  const int nx = std::max(1, static_cast<int>(std::ceil(size.x() / side - 0.02)));
+  const int ny = std::max(1, static_cast<int>(std::ceil(size.y() / side - 0.02)));
   // Tiles split the extent evenly, so the last ones are not slivers.
   const Eigen::Vector2d tile(size.x() / nx, size.y() / ny);
   std::vector<bool> used(block.images.size(), false);

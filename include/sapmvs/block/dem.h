@@ -11,9 +11,16 @@ namespace sapmvs {
 
 class Dem {
  public:
-  // Reads band 1 of `path`; throws naming the file when it is not a north-up
-  // raster GDAL can read.
-  static Dem Load(const std::filesystem::path& path);
+  // The most cells Load keeps: the plan finds each image's ground with one
+  // ray, at the scale of its footprint, not of a DEM that may be the
+  // simulator's truth at a fraction of the GSD (the 60-image 12 MP flight's:
+  // 190 M cells, 760 MB, which the plan's peak held twice).
+  static constexpr long kMaxCells = 1L << 24;
+  // Reads band 1 of `path`, a raster of more than max_cells cells as the
+  // mean of the valid ones of f x f of its cells (the least f that fits,
+  // the last f - 1 rows and columns at most left out); throws naming the
+  // file when it is not a north-up raster GDAL can read.
+  static Dem Load(const std::filesystem::path& path, long max_cells = kMaxCells);
 
   // Bilinear height at world (x, y) between cell centres; NaN outside the
   // raster or where a corner is nodata.
