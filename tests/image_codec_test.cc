@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "sapmvs/util/error.h"
@@ -57,6 +58,22 @@ TEST_F(ImageCodecTest, LosslessFormatsRoundTripAndOpenCvReadsThem) {
     // An independent decoder sees the same pixels in the same channel order.
     EXPECT_EQ(MaxDifference(cv::imread(file.string(), cv::IMREAD_COLOR), image), 0);
   }
+}
+
+// What a plan counts GDAL's libraries for (GdalBytesToMatch): JPEG and PNG
+// by their first bytes, whatever the name; not TIFF, nor a missing file.
+TEST_F(ImageCodecTest, JpegAndPngAloneAreDecodedWithoutGdal) {
+  const cv::Mat image = RandomImage(CV_8UC3, 4);
+  const std::vector<std::tuple<ImageEncoding, std::string, bool>> formats = {
+      {ImageEncoding::kPng, "a.tif", true},
+      {ImageEncoding::kJpeg, "b.png", true},
+      {ImageEncoding::kTiff, "c.jpg", false},
+      {ImageEncoding::kBmp, "d.bmp", false}};
+  for (const auto& [encoding, name, without] : formats) {
+    WriteFile(dir_ / name, EncodeImage(image, encoding, name));
+    EXPECT_EQ(DecodedWithoutGdal(dir_ / name), without) << name;
+  }
+  EXPECT_FALSE(DecodedWithoutGdal(dir_ / "missing.jpg"));
 }
 
 TEST_F(ImageCodecTest, GreyIsRepeatedInTheThreeChannels) {

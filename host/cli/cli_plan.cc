@@ -17,6 +17,7 @@
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/block_reader.h"
 #include "sapmvs/io/raster_io.h"
+#include "sapmvs/match/match_group.h"
 #include "sapmvs/plan/grouping.h"
 #include "sapmvs/util/atomic_file.h"
 #include "sapmvs/util/error.h"
@@ -67,7 +68,7 @@ void RegisterPlanCommand(CLI::App& app, const GlobalFlags& /*global*/) {
     }
     ReleaseFreeMemory();
     const GroupingPlan plan = PlanGroups(block, args->grouping, args->matcher, &geometry,
-                                         CurrentRssBytes() + GdalBytesToLoad());
+                                         CurrentRssBytes() + GdalBytesToMatch(block));
     PrintPlan(block, plan, std::cout);
     if (!args->json.empty()) {
       WriteTextAtomically(args->json, PlanToJson(block, plan).dump(2) + "\n");

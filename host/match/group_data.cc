@@ -9,11 +9,13 @@
 
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/image_io.h"
+#include "sapmvs/io/raster_io.h"
 #include "sapmvs/match/match_group.h"
 #include "sapmvs/match/matcher_options.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/kernel_limits.h"
 #include "sapmvs/util/parallel_for.h"
+#include "util/image_codec.h"
 
 namespace sapmvs {
 
@@ -22,6 +24,12 @@ double TriangulationAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   const Eigen::Vector3d ra = (a - x).normalized();
   const Eigen::Vector3d rb = (b - x).normalized();
   return std::acos(std::clamp(ra.dot(rb), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+double GdalBytesToMatch(const Block& block) {
+  for (const BlockImage& image : block.images)
+    if (!DecodedWithoutGdal(image.path)) return GdalBytesToLoad();
+  return 0;
 }
 
 MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,

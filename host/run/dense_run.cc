@@ -160,7 +160,7 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   ReleaseFreeMemory();
   const GroupingPlan plan =
       PlanGroups(block, options.grouping, options.matcher, &geometry,
-                 dispatch.PlanProcessBytes(CurrentRssBytes() + GdalBytesToLoad()));
+                 dispatch.PlanProcessBytes(CurrentRssBytes() + GdalBytesToMatch(block)));
   report.strategy = plan.single_group ? "single group" : ToString(plan.strategy);
   for (const int i : plan.ungrouped) report.ungrouped.push_back(block.images[i].name);
   end_stage("plan");

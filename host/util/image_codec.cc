@@ -187,6 +187,8 @@ cv::Mat DecodeImageFile(const std::filesystem::path& path) {
   return DecodeImageWithGdal(path);
 }
 
+bool DecodedWithoutGdal(const std::filesystem::path& path) { return Sniff(path) != Format::kOther; }
+
 cv::Size ReadImageFileSize(const std::filesystem::path& path) {
   cv::Size size;
   if (DecodeHere(path, nullptr, &size)) return size;

@@ -24,6 +24,10 @@ enum class ImageEncoding { kPng, kJpeg, kTiff, kBmp, kPpm };
 // neither 8- nor 16-bit integers.
 cv::Mat DecodeImageFile(const std::filesystem::path& path);
 
+// Whether DecodeImageFile decodes the file without GDAL (JPEG, PNG; from
+// its first bytes). False for a file it cannot read.
+bool DecodedWithoutGdal(const std::filesystem::path& path);
+
 // Width and height from the file's header.
 cv::Size ReadImageFileSize(const std::filesystem::path& path);
 

@@ -92,8 +92,8 @@ class GeoOutputsCheck {
 // where GDAL is linked in or already loaded, and in the binary, before it
 // loads its GDAL module, what GDAL and its libraries held at the end of a
 // run on `small` (30 MiB, with the drivers the outputs register), rounded
-// up. Plans count it as part of the process, so that a memory budget also
-// bounds the outputs' peak.
+// up. Plans count it in the process where the groups' images load it
+// (GdalBytesToMatch).
 double GdalBytesToLoad();
 
 // How a report names a CRS: its EPSG code (0 when it has none that PROJ can

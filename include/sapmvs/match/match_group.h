@@ -49,6 +49,12 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
 // holds its full-resolution pixels and an undistorted copy while it is read.
 constexpr int kImagesReadAtOnce = 2;
 
+// What loading GDAL adds to a process that matches `block` (GdalBytesToLoad):
+// the first group loads it where an image is of a format only GDAL decodes;
+// JPEG and PNG are decoded without it, and a run then loads it for its
+// outputs only, once the groups are matched (0).
+double GdalBytesToMatch(const Block& block);
+
 // What matching one group holds, per unit, for the planner's memory model
 // (grouping.h EstimateGroupMemory, which spells out each term): per pixel of
 // the group's images on the device and on the host, per pixel that can take
