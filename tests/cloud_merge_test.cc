@@ -173,7 +173,9 @@ TEST(CloudMerge, BothGroupsAreKeptWithinTheBlendBandOfTheirBorder) {
     const double x = groups[r.group].cloud->points[r.index].position.x();
     kept_in_band += std::abs(x - 500010.0) < band;
     // Beyond the band only the owner's points stay.
-    if (std::abs(x - 500010.0) >= band) EXPECT_TRUE(r.core) << r.group << " at " << x;
+    if (std::abs(x - 500010.0) >= band) {
+      EXPECT_TRUE(r.core) << r.group << " at " << x;
+    }
   }
   EXPECT_EQ(kept_in_band, in_band);
   EXPECT_GT(in_band, 0);

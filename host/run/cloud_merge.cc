@@ -5,9 +5,11 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
+#include "sapmvs/run/core_index.h"
 #include "sapmvs/util/error.h"
 
 namespace sapmvs {
@@ -213,7 +215,8 @@ std::vector<uint8_t> MayHaveForeignNeighbour(const std::vector<GroupCloud>& grou
 }  // namespace
 
 std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
-                                      const MergeOptions& options, MergeStats* stats) {
+                                      const MergeOptions& options, MergeStats* stats,
+                                      const CoreIndex* cores) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("merge: expected " + problem);
   MergeStats local;
@@ -249,6 +252,8 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   };
   const double wide = options.radius * options.outside_core_radii;
   const double blend_width = options.radius * options.blend_radii;
+  std::optional<CoreIndex> own_cores;
+  if (!cores) cores = &own_cores.emplace(centers, blend_width);
   const std::vector<uint8_t> contested = MayHaveForeignNeighbour(groups, wide);
   std::vector<Item> items(contested.size());
   size_t flat = 0;
@@ -260,8 +265,8 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     for (size_t i = 0; i < pts.size(); ++i) {
       // The distance to the border only where a blend band asks for it.
       const double x = pts[i].position.x(), y = pts[i].position.y();
-      const auto [owner, border] = blend_width > 0 ? CoreOwnerAndBorder(centers, x, y)
-                                                   : std::pair{CoreOwner(centers, x, y), 0.0};
+      const auto [owner, border] =
+          blend_width > 0 ? cores->OwnerAndBorder({x, y}) : std::pair{cores->Owner({x, y}), 0.0};
       const bool core = owner == static_cast<int>(g);
       items[flat + i] = {{static_cast<int>(g), i},
                          core,

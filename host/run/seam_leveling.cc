@@ -37,28 +37,13 @@ std::string SeamOptions::Problem() const {
 }
 
 SeamLeveling::SeamLeveling(std::vector<Eigen::Vector2d> centers, const SeamOptions& options)
-    : centers_(std::move(centers)), options_(options) {
+    : centers_(std::move(centers)), options_(options), cores_(centers_, options.band) {
   if (const std::string p = options.Problem(); !p.empty()) throw Error("seams: expected " + p);
-}
-
-std::pair<int, int> SeamLeveling::TwoNearest(const Eigen::Vector2d& p) const {
-  int first = -1, second = -1;
-  double d1 = 0, d2 = 0;
-  for (int g = 0; g < static_cast<int>(centers_.size()); ++g) {
-    const double d = (p - centers_[g]).squaredNorm();
-    if (first < 0 || d < d1) {
-      second = first, d2 = d1;
-      first = g, d1 = d;
-    } else if (second < 0 || d < d2) {
-      second = g, d2 = d;
-    }
-  }
-  return {first, second};
 }
 
 void SeamLeveling::Add(int g, const Eigen::Vector3d& p) {
   const Eigen::Vector2d xy = p.head<2>();
-  const auto [owner, next] = TwoNearest(xy);
+  const auto [owner, next] = cores_.TwoNearest(xy);
   if (next < 0) return;
   // The border the point lies by: its owner's with the next nearest centre.
   if (g != owner && g != next) return;
@@ -100,13 +85,19 @@ void SeamLeveling::Finish() {
     pair_offset_[key] = std::abs(d) <= options_.max_offset ? d : 0.0;
   }
   median_offset_ = levelled.empty() ? 0 : Median(levelled);
+  measured_with_.assign(centers_.size(), {});
+  for (const auto& [key, offset] : pair_offset_) {
+    measured_with_[key.first].push_back(key.second);
+    measured_with_[key.second].push_back(key.first);
+  }
+  for (std::vector<int>& with : measured_with_) std::sort(with.begin(), with.end());
 }
 
 double SeamLeveling::Correction(int g, const Eigen::Vector3d& p) const {
   const Eigen::Vector2d xy = p.head<2>();
   double dz = 0;
-  for (int h = 0; h < static_cast<int>(centers_.size()); ++h) {
-    if (h == g) continue;
+  if (g < 0 || g >= static_cast<int>(measured_with_.size())) return dz;
+  for (const int h : measured_with_[g]) {
     const double t = BeyondBisector(centers_[g], centers_[h], xy);
     if (!(t < options_.feather)) continue;
     const int a = std::min(g, h), b = std::max(g, h);

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 
+#include "sapmvs/run/core_index.h"
 #include "sapmvs/run/seam_leveling.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/parallel_for.h"
@@ -130,10 +131,15 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
 
   std::vector<PointCloud> clouds(n);
   std::vector<GroupCloud> parts(n);
+  std::vector<Eigen::Vector2d> centers(n);
   for (size_t g = 0; g < n; ++g) {
     parts[g].cloud = &clouds[g];
-    parts[g].center = groups[g].center;
+    parts[g].center = centers[g] = groups[g].center;
   }
+  // Once for all tiles: over the block's extent, a grid cell per quarter of
+  // a group's ground.
+  const CoreIndex cores(std::move(centers), options.radius * options.blend_radii,
+                        {block.xmin, block.ymin}, {block.xmax, block.ymax});
   for (int ty = 0; ty < layout.tiles_y; ++ty) {
     for (int tx = 0; tx < layout.tiles_x; ++tx) {
       Box reach = block;  // the tile and its halo
@@ -170,7 +176,7 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
           },
           1);
       MergeStats tile_stats;
-      std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats);
+      std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats, &cores);
       PointCloud tile = layout.format;
       tile.points.reserve(
           static_cast<size_t>(std::count_if(refs.begin(), refs.end(), [&](const MergedRef& ref) {

@@ -22,6 +22,8 @@
 
 namespace sapmvs {
 
+class CoreIndex;
+
 struct GroupCloud {
   const PointCloud* cloud = nullptr;
   Eigen::Vector2d center = Eigen::Vector2d::Zero();  // world XY of the group's ground centre
@@ -90,8 +92,12 @@ struct MergedRef {
 // What MergeGroupClouds keeps, in its output order (group, then index). A
 // group's cloud may hold only some of its points (a tile of the block, see
 // tiled_merge.h): every group's centre still takes part in the cores.
+// `cores`, the groups' centres indexed with options.radius * blend_radii as
+// their reach, saves a caller that merges many tiles building it for each
+// (CoreIndex); without, it is built from the groups' centres.
 std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
-                                      const MergeOptions& options, MergeStats* stats = nullptr);
+                                      const MergeOptions& options, MergeStats* stats = nullptr,
+                                      const CoreIndex* cores = nullptr);
 
 // The index of the centre nearest to (x, y): the core owner; -1 for none.
 int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y);

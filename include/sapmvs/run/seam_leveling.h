@@ -16,6 +16,8 @@
 #include <tuple>
 #include <vector>
 
+#include "sapmvs/run/core_index.h"
+
 namespace sapmvs {
 
 struct SeamOptions {
@@ -56,11 +58,12 @@ class SeamLeveling {
   double median_offset() const { return median_offset_; }
 
  private:
-  // The nearest and the next nearest centre to p.
-  std::pair<int, int> TwoNearest(const Eigen::Vector2d& p) const;
-
   std::vector<Eigen::Vector2d> centers_;
   SeamOptions options_;
+  CoreIndex cores_;  // the points' nearest centres, within the band
+  // Per group, the groups whose border with it was measured, ascending:
+  // those Correction sums over.
+  std::vector<std::vector<int>> measured_with_;
   // Heights of pair (a < b)'s cells, per side: (a, b, cell x, cell y, side).
   std::map<std::tuple<int, int, int64_t, int64_t, int>, std::vector<float>> heights_;
   // Offsets z_a - z_b per stretch of a border (a, b, stretch x, stretch y),
