@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "sapmvs/util/error.h"
+#include "sapmvs/util/parallel_for.h"
 
 namespace sapmvs {
 namespace {
@@ -67,32 +68,37 @@ void StreamedDsm::Add(PointSpan points) {
 }
 
 GeoRaster StreamedDsm::Finish(int fill_passes) {
-  std::vector<Height> heights;
-  std::vector<float> cell_heights;
-  for (Band& band : bands_) {
-    heights.resize(band.spilled);
-    if (band.spilled > 0) {
-      std::ifstream in(band.file->temp_path(), std::ios::binary);
-      in.read(reinterpret_cast<char*>(heights.data()),
-              static_cast<std::streamsize>(band.spilled * sizeof(Height)));
-      if (!in) throw Error(band.file->temp_path().string() + ": read failed");
-      band.file.reset();
-    }
-    heights.insert(heights.end(), band.buffer.begin(), band.buffer.end());
-    std::vector<Height>().swap(band.buffer);  // `= {}` would keep its capacity
-    // By cell; a cell's median does not depend on the order of its heights.
-    std::sort(heights.begin(), heights.end(),
-              [](const Height& a, const Height& b) { return a.cell < b.cell; });
-    for (size_t i = 0; i < heights.size();) {
-      size_t j = i;
-      cell_heights.clear();
-      while (j < heights.size() && heights[j].cell == heights[i].cell) {
-        cell_heights.push_back(heights[j++].z);
-      }
-      dsm_.values[heights[i].cell] = MedianHeight(&cell_heights);
-      i = j;
-    }
-  }
+  // Two bands at a time: each is one core's read, sort and medians, and
+  // their cells are rows of their own.
+  ParallelFor(
+      static_cast<long>(bands_.size()),
+      [&](long k) {
+        Band& band = bands_[static_cast<size_t>(k)];
+        std::vector<Height> heights(band.spilled);
+        std::vector<float> cell_heights;
+        if (band.spilled > 0) {
+          std::ifstream in(band.file->temp_path(), std::ios::binary);
+          in.read(reinterpret_cast<char*>(heights.data()),
+                  static_cast<std::streamsize>(band.spilled * sizeof(Height)));
+          if (!in) throw Error(band.file->temp_path().string() + ": read failed");
+          band.file.reset();
+        }
+        heights.insert(heights.end(), band.buffer.begin(), band.buffer.end());
+        std::vector<Height>().swap(band.buffer);  // `= {}` would keep its capacity
+        // By cell; a cell's median does not depend on the order of its heights.
+        std::sort(heights.begin(), heights.end(),
+                  [](const Height& a, const Height& b) { return a.cell < b.cell; });
+        for (size_t i = 0; i < heights.size();) {
+          size_t j = i;
+          cell_heights.clear();
+          while (j < heights.size() && heights[j].cell == heights[i].cell) {
+            cell_heights.push_back(heights[j++].z);
+          }
+          dsm_.values[heights[i].cell] = MedianHeight(&cell_heights);
+          i = j;
+        }
+      },
+      1, 2);
   FillDsmGaps(&dsm_, fill_passes);
   return std::move(dsm_);
 }

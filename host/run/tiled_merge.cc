@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <optional>
 
@@ -140,6 +141,9 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
   // a group's ground.
   const CoreIndex cores(std::move(centers), options.radius * options.blend_radii,
                         {block.xmin, block.ymin}, {block.xmax, block.ymax});
+  // The caller's work on a tile (its outputs: one core's) runs beside the
+  // next tile's reading and merging, tiles still handed over in order.
+  std::future<void> emitting;
   for (int ty = 0; ty < layout.tiles_y; ++ty) {
     for (int tx = 0; tx < layout.tiles_x; ++tx) {
       Box reach = block;  // the tile and its halo
@@ -199,9 +203,13 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
       st.input += input;
       st.kept += static_cast<long>(tile.points.size());
       st.duplicates += input - static_cast<long>(tile.points.size());
-      if (!tile.points.empty()) emit(tile, layout);
+      if (tile.points.empty()) continue;
+      if (emitting.valid()) emitting.get();
+      emitting = std::async(std::launch::async,
+                            [&emit, &layout, done = std::move(tile)] { emit(done, layout); });
     }
   }
+  if (emitting.valid()) emitting.get();
   return st;
 }
 

@@ -55,7 +55,8 @@ struct MergeLayout {
 };
 
 // Kept points of one tile, in the merge's order (group, then index), with the
-// layout; called once per tile that keeps points, tiles row by row.
+// layout; called once per tile that keeps points, tiles row by row, one call
+// at a time, on a thread of its own while the next tile is merged.
 using MergedTile = std::function<void(const PointCloud& tile, const MergeLayout& layout)>;
 
 // Merges `groups` tile by tile, reading each group once to find its extent and
