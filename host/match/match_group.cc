@@ -70,9 +70,9 @@ MatcherMemoryModel MatcherMemory() {
   // not a view's, not outside a footprint group's tile), and per pixel, not
   // per cell, as points are emitted per pixel: 13 bytes put every group of
   // `small`, `city`, `campus`, Herz-Jesu-P8, the Caliterra flight and
-  // simulated 12 MP flights of 20 and 60 images within -12 to +12 % of its
+  // simulated 12 MP flights of 20 and 60 images within -12 to +15 % of its
   // measured peak, and `tiny` at level 0 with cells of 2 and of 1 pixel
-  // within -10 to -5 % (profiling/results/memory.md).
+  // +10 and +5 % (profiling/results/memory.md).
   m.host_bytes_per_point_pixel = 13;
   m.device_bytes_per_candidate = batch.per_patch + views * batch.per_pair;
   m.host_bytes_per_candidate =

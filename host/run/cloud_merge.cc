@@ -47,37 +47,11 @@ std::string MergeOptions::Problem() const {
   return "";
 }
 
-int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
-  int best = -1;
-  double best_d2 = 0;
-  for (size_t g = 0; g < centers.size(); ++g) {
-    const double d2 = (Eigen::Vector2d(x, y) - centers[g]).squaredNorm();
-    if (best < 0 || d2 < best_d2) {
-      best = static_cast<int>(g);
-      best_d2 = d2;
-    }
-  }
-  return best;
-}
-
 double BeyondBisector(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                       const Eigen::Vector2d& p) {
   const double length = (b - a).norm();
   if (!(length > 0)) return std::numeric_limits<double>::infinity();
   return ((p - b).squaredNorm() - (p - a).squaredNorm()) / (2 * length);
-}
-
-std::pair<int, double> CoreOwnerAndBorder(const std::vector<Eigen::Vector2d>& centers, double x,
-                                          double y) {
-  const int own = CoreOwner(centers, x, y);
-  double border = std::numeric_limits<double>::infinity();
-  if (own < 0) return {own, border};
-  const Eigen::Vector2d p(x, y);
-  for (size_t g = 0; g < centers.size(); ++g) {
-    if (static_cast<int>(g) != own)
-      border = std::min(border, BeyondBisector(centers[own], centers[g], p));
-  }
-  return {own, border};
 }
 
 namespace {

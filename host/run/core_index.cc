@@ -20,7 +20,62 @@ double DistanceToBox(const Eigen::Vector2d& p, const Eigen::Vector2d& lo,
   return (p.cwiseMax(lo).cwiseMin(hi) - p).norm();
 }
 
+// The nearest of `ids` (ascending) to p, ties to the lower index; -1 for
+// none.
+template <typename Ids>
+int NearestOf(const std::vector<Eigen::Vector2d>& centers, const Ids& ids,
+              const Eigen::Vector2d& p) {
+  int best = -1;
+  double best_d2 = 0;
+  for (const int g : ids) {
+    const double d2 = (p - centers[g]).squaredNorm();
+    if (best < 0 || d2 < best_d2) {
+      best = g;
+      best_d2 = d2;
+    }
+  }
+  return best;
+}
+
+// NearestOf, and p's distance to the border of its core with each other
+// centre of `ids`, the least.
+template <typename Ids>
+std::pair<int, double> NearestOfAndBorder(const std::vector<Eigen::Vector2d>& centers,
+                                          const Ids& ids, const Eigen::Vector2d& p) {
+  const int own = NearestOf(centers, ids, p);
+  double border = std::numeric_limits<double>::infinity();
+  if (own < 0) return {own, border};
+  for (const int g : ids)
+    if (g != own) border = std::min(border, BeyondBisector(centers[own], centers[g], p));
+  return {own, border};
+}
+
+// 0 .. n - 1, for a loop over every centre without a list of them.
+struct AllOf {
+  int n;
+  struct Iterator {
+    int i;
+    int operator*() const { return i; }
+    Iterator& operator++() {
+      ++i;
+      return *this;
+    }
+    bool operator!=(const Iterator& o) const { return i != o.i; }
+  };
+  Iterator begin() const { return {0}; }
+  Iterator end() const { return {n}; }
+};
+
 }  // namespace
+
+int CoreOwner(const std::vector<Eigen::Vector2d>& centers, double x, double y) {
+  return NearestOf(centers, AllOf{static_cast<int>(centers.size())}, {x, y});
+}
+
+std::pair<int, double> CoreOwnerAndBorder(const std::vector<Eigen::Vector2d>& centers, double x,
+                                          double y) {
+  return NearestOfAndBorder(centers, AllOf{static_cast<int>(centers.size())}, {x, y});
+}
 
 CoreIndex::CoreIndex(std::vector<Eigen::Vector2d> centers, double reach, const Eigen::Vector2d& lo,
                      const Eigen::Vector2d& hi)
@@ -85,26 +140,11 @@ const std::vector<int>& CoreIndex::Candidates(const Eigen::Vector2d& p) const {
 }
 
 int CoreIndex::Owner(const Eigen::Vector2d& p) const {
-  // In index order with a strict test, as CoreOwner: ties go to the lower.
-  int best = -1;
-  double best_d2 = 0;
-  for (const int g : Candidates(p)) {
-    const double d2 = (p - centers_[g]).squaredNorm();
-    if (best < 0 || d2 < best_d2) {
-      best = g;
-      best_d2 = d2;
-    }
-  }
-  return best;
+  return NearestOf(centers_, Candidates(p), p);
 }
 
 std::pair<int, double> CoreIndex::OwnerAndBorder(const Eigen::Vector2d& p) const {
-  const int own = Owner(p);
-  double border = std::numeric_limits<double>::infinity();
-  if (own < 0) return {own, border};
-  for (const int g : Candidates(p))
-    if (g != own) border = std::min(border, BeyondBisector(centers_[own], centers_[g], p));
-  return {own, border};
+  return NearestOfAndBorder(centers_, Candidates(p), p);
 }
 
 std::pair<int, int> CoreIndex::TwoNearest(const Eigen::Vector2d& p) const {

@@ -1,9 +1,9 @@
 #pragma once
 // The DSM and footprint of a merged cloud read in chunks (RasterizeDsm and
-// MeasureFootprint of cloud_dsm.h, with the same results), holding a band of
-// the raster's heights at a time rather than the block's: each point's
+// MeasureFootprint of cloud_dsm.h, with the same results), holding two bands
+// of the raster's heights at a time rather than the block's: each point's
 // height goes to the band of raster rows it falls in, spilled to a temporary
-// file per band, and each band's cells take their medians in turn.
+// file per band, and the bands' cells take their medians two bands at once.
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
