@@ -34,19 +34,26 @@ mkdir -p "$out/images"
 gitdir=""
 if [ -d "$src/.git" ]; then gitdir="$src/.git"; elif [ -f "$src/HEAD" ]; then gitdir="$src"; fi
 if [ -n "$gitdir" ]; then
-  for f in $(git --git-dir="$gitdir" ls-tree --name-only HEAD | grep -i '\.jpg$'); do
+  # The photos lie at the top of early commits and under images/ of later ones.
+  for path in $(git --git-dir="$gitdir" ls-tree -r --name-only HEAD | grep -i '\.jpg$'); do
+    f=$(basename "$path")
     [ -s "$out/images/$f" ] && continue
-    if git --git-dir="$gitdir" cat-file -e "HEAD:$f" 2>/dev/null; then
-      git --git-dir="$gitdir" cat-file blob "HEAD:$f" >"$out/images/$f.part"
+    if git --git-dir="$gitdir" cat-file -e "HEAD:$path" 2>/dev/null; then
+      git --git-dir="$gitdir" cat-file blob "HEAD:$path" >"$out/images/$f.part"
       mv "$out/images/$f.part" "$out/images/$f"
     else
-      echo "$0: $f is not in the snapshot; left out"
+      echo "$0: $path is not in the snapshot; left out"
     fi
   done
 else
   cp -n "$src"/*.[jJ][pP][gG] "$out/images/"
 fi
-echo "$0: $(ls "$out/images" | wc -l) images in $out/images"
+count=$(ls "$out/images" | wc -l)
+echo "$0: $count images in $out/images"
+if [ "$count" -eq 0 ]; then
+  echo "$0: $src: no JPEG photos found (expected *.jpg at its top or under images/)" >&2
+  exit 1
+fi
 
 db=$out/database.db
 if [ ! -f "$out/.features" ]; then
