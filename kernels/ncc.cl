@@ -53,10 +53,11 @@ typedef struct {
 
 // One patch (host: NccPatch, 48 bytes).
 typedef struct {
-  float4 center;  // xyz: patch centre c (local); w ignored.
-  float4 normal;  // xyz: unit normal n; w ignored.
-  int reference;  // Index of the reference image R(p).
-  int reserved0, reserved1, reserved2;
+  float4 center;   // xyz: patch centre c (local); w ignored.
+  float4 normal;   // xyz: unit normal n; w ignored.
+  int reference;   // Index of the reference image R(p).
+  int directions;  // The refinement's: 2 = depth only, else depth and normal.
+  int reserved1, reserved2;
 } NccPatch;
 
 #include "bilinear.cl"

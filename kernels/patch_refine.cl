@@ -106,6 +106,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   const NccCamera ref = cameras[patch.reference];
   const float3 c0 = patch.center.xyz;
   const PatchFrame f = patch_frame(ref, c0);
+  const int directions = search_directions(patch);
 
   float p[3];
   float step[3];
@@ -154,8 +155,8 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   int lead = 0;  // the direction that moved last, tried first
   for (int it = 0; it < iterations && halvings < max_halvings; ++it) {
     int moved = -1;
-    for (int j = 0; j < 6 && moved < 0; ++j) {
-      const int k = (lead + j) % 6;
+    for (int j = 0; j < directions && moved < 0; ++j) {
+      const int k = (lead + j) % directions;
       float q[3];
       if (!poll_candidate(p, step, k, cos_max, q)) {
         continue;

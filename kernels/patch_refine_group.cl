@@ -88,6 +88,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
   const NccCamera ref = cameras[patch.reference];
   const float3 c0 = patch.center.xyz;
   const PatchFrame f = patch_frame(ref, c0);
+  const int directions = search_directions(patch);
 
   float p[3];
   float step[3];
@@ -187,7 +188,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
         k = -1;
         all = true;
       } else {
-        if (polled == 6 || moved >= 0) {
+        if (polled == directions || moved >= 0) {
           if (moved >= 0) {
             lead = moved;
             ++moves;
@@ -206,7 +207,7 @@ __kernel __attribute__((reqd_work_group_size(WORK_GROUP_SIZE, 1, 1))) void patch
           done = true;
           continue;
         }
-        k = (lead + polled) % 6;
+        k = (lead + polled) % directions;
         ++polled;
         if (!poll_candidate(p, step, k, cos_max, q)) {
           continue;

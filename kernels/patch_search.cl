@@ -104,6 +104,9 @@ void search_start(const PatchFrame f, float3 n0, float depth_step, float angle_s
 // ray whose half-angle has the cosine cos_max.
 bool in_cone(const float* p, float cos_max) { return cos(p[1]) * cos(p[2]) >= cos_max; }
 
+// The search directions of a patch: 2 (+t, -t) or all 6.
+int search_directions(const NccPatch patch) { return patch.directions == 2 ? 2 : 6; }
+
 // Candidate k (+t, -t, +yaw, -yaw, +pitch, -pitch) around p into q; false when
 // its normal lies outside the cone (in_cone).
 bool poll_candidate(const float* p, const float* step, int k, float cos_max, float* q) {

@@ -268,6 +268,38 @@ TEST_P(PatchRefinerTest, StopsAfterMaxHalvings) {
   EXPECT_GT(fewer, 0);
 }
 
+// A patch with directions = 2 searches its depth alone: its normal comes back
+// as it went in (to float precision), and on the true normal the depth still reaches
+// the plane, for fewer scores than the full search of the same starts.
+TEST_P(PatchRefinerTest, DepthOnlyKeepsTheNormalAndFindsTheDepth) {
+  const PlaneScene scene = MakePlaneScene(4, 161, 123, 51);
+  std::vector<NccPatch> patches;
+  std::vector<std::vector<int>> views;
+  PerturbedPatches(scene, 12, 1.5, 0.0, 53, &patches, &views);
+  PatchRefinerOptions options = Options();
+  options.patch_size = 11;
+  std::vector<RefinedPatch> full;
+  RefineAndCompare(scene, patches, views, options, &full);
+  for (NccPatch& p : patches) p.directions = 2;
+  std::vector<RefinedPatch> depth_only;
+  const RefComparison vs = RefineAndCompare(scene, patches, views, options, &depth_only);
+  ASSERT_EQ(depth_only.size(), patches.size());
+  long full_scores = 0, depth_scores = 0;
+  for (size_t i = 0; i < patches.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(depth_only[i].patch.normal.s[k], patches[i].normal.s[k], 1e-6) << "patch " << i;
+    }
+    const Eigen::Vector3d c(depth_only[i].patch.center.s[0], depth_only[i].patch.center.s[1],
+                            depth_only[i].patch.center.s[2]);
+    EXPECT_LT(DepthErrorFootprints(scene.cameras[0], c), 0.25) << "patch " << i;
+    full_scores += full[i].evaluations;
+    depth_scores += depth_only[i].evaluations;
+  }
+  EXPECT_LT(depth_scores, full_scores);
+  std::printf("[ REFINE   ] depth only: %ld scores against %ld, %d/%zu same-path\n", depth_scores,
+              full_scores, vs.same_path, patches.size());
+}
+
 // Sample weights (sigma_color 3, the matcher's default): the weighted search
 // takes the reference's path where its decisions are clear, and converges to
 // the plane as the plain one does (ConvergesToThePlaneAndMatchesReference).

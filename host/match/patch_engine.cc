@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iterator>
 
 #include "match/footprint.h"
@@ -61,6 +62,7 @@ PatchRefinerOptions ExpansionOptionsOf(const MatcherOptions& options, PatchEngin
   ro.angle_step_deg = kExpansionRefineAngleStepDeg;
   ro.max_halvings =
       role == PatchEngine::Role::kOneCellPass ? kOneCellRefineHalvings : kExpansionRefineHalvings;
+  if (role == PatchEngine::Role::kOneCellPass) ro.iterations = kOneCellRefineIterations;
   return ro;
 }
 
@@ -409,16 +411,29 @@ std::vector<std::optional<AcceptedPatch>> PatchEngine::EvaluateBatch(
   std::vector<NccPatch> to_refine;
   std::vector<std::vector<int>> refine_views;
   std::vector<int> refine_of;
+  std::vector<float> kept_scores;
   size_t pair_index = 0;
   for (size_t k = 0; k < patches.size(); ++k) {
     std::vector<int> kept;
+    kept_scores.clear();
     for (const int v : visible[k]) {
       const float s = before[pair_index++];
-      if (std::isfinite(s) && s >= options_.threshold_before) kept.push_back(v);
+      if (std::isfinite(s) && s >= options_.threshold_before) {
+        kept.push_back(v);
+        kept_scores.push_back(s);
+      }
     }
     if (static_cast<int>(kept.size()) < need) continue;
     if (!WideEnough(candidates[patch_of[k]].center, candidates[patch_of[k]].ref, kept)) continue;
     to_refine.push_back(patches[k]);
+    // A one-cell candidate whose parent's plane already scores
+    // kOneCellDepthOnlyScore in as many views as acceptance asks for is
+    // explained by that plane: its depth is searched, its normal kept.
+    if (role_ == Role::kOneCellPass && candidates[patch_of[k]].has_parent) {
+      std::nth_element(kept_scores.begin(), kept_scores.begin() + (need - 1), kept_scores.end(),
+                       std::greater<float>());
+      if (kept_scores[need - 1] >= kOneCellDepthOnlyScore) to_refine.back().directions = 2;
+    }
     refine_views.push_back(std::move(kept));
     refine_of.push_back(patch_of[k]);
   }

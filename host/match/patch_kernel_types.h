@@ -57,7 +57,10 @@ struct NccPatch {
   Float4 center;          // xyz: centre c, local frame; w ignored.
   Float4 normal;          // xyz: unit normal n; w ignored.
   int32_t reference = 0;  // Index of the reference image R(p) in the group.
-  int32_t reserved[3] = {0, 0, 0};
+  // The refinement's search directions: 2 = depth only (the normal kept),
+  // anything else depth and both angles. The scorer ignores it.
+  int32_t directions = 6;
+  int32_t reserved[2] = {0, 0};
 };
 static_assert(sizeof(NccPatch) == 48, "NccPatch must match the kernel's struct");
 static_assert(alignof(NccPatch) == 16, "NccPatch must be float4-aligned");

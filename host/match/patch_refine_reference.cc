@@ -102,8 +102,9 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
     r.evaluations = 1;
     for (int it = 0; it < options.iterations && halvings < options.max_halvings; ++it) {
       int moved = -1;
-      for (int j = 0; j < 6 && moved < 0; ++j) {
-        const int k = (lead + j) % 6;
+      const int directions = patch.directions == 2 ? 2 : 6;
+      for (int j = 0; j < directions && moved < 0; ++j) {
+        const int k = (lead + j) % directions;
         double q[3] = {p[0], p[1], p[2]};
         q[k / 2] += (k % 2 == 0) ? step[k / 2] : -step[k / 2];
         // Out-of-range angles are skipped without a score, as in the kernel.
