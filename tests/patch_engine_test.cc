@@ -407,6 +407,54 @@ TEST_F(PatchEngineTest, OneCellPassPatchesNeedAViewTwiceMaxAngleFromTheReference
   EXPECT_EQ(accepted(pass, PatchEngine::Role::kOneCellPass), 8);
 }
 
+// A pmvs pass's one-cell candidate whose parent's plane already scores
+// kOneCellDepthOnlyScore in the views acceptance needs searches its depth
+// alone: the accepted patch keeps the parent's normal, a few degrees off the
+// ground's, and still finds the ground's depth. The same candidates refined
+// as patches of pmvs mode turn their normals.
+TEST_F(PatchEngineTest, OneCellCandidatesOnAPlaneThatHoldsKeepTheParentsNormal) {
+  const PlaneScene scene = MakePlaneScene(4, 201, 161, 91);
+  const MatchGroupData group = test::MatchGroupOf(scene);
+  MatcherOptions sapmvs;
+  MatcherOptions pass = PmvsPassOptions(sapmvs);
+  pass.max_angle_deg = 2.0;  // the scene's views lie a few degrees apart
+  std::vector<PatchCandidate> candidates = TiltedSeeds(scene, 10, 0.3, 4.0, 93);
+  for (PatchCandidate& c : candidates) {
+    c.has_parent = true;
+    c.parent_center = c.center;
+    c.parent_normal = c.normal;
+    c.parent_score = 0.95f;
+  }
+  const Camera& ref = scene.cameras[0];
+  auto turned_deg = [](const PatchCandidate& c, const AcceptedPatch& a) {
+    const double cosine = std::clamp(a.normal.normalized().dot(c.normal.normalized()), -1.0, 1.0);
+    return std::acos(cosine) * 180.0 / kPiRad;
+  };
+  int kept = 0, turned = 0;
+  for (const PatchEngine::Role role :
+       {PatchEngine::Role::kOneCellPass, PatchEngine::Role::kPatches}) {
+    PatchEngine engine(NewKernels(), group, pass, role);
+    const auto results = engine.Evaluate(candidates);
+    ASSERT_EQ(results.size(), candidates.size());
+    for (size_t i = 0; i < results.size(); ++i) {
+      ASSERT_TRUE(results[i]) << "candidate " << i;
+      const AcceptedPatch& a = *results[i];
+      const Eigen::Vector3d truth = GroundAt(ref, ref.Project(a.center));
+      EXPECT_LT(std::abs(ref.Depth(a.center) - ref.Depth(truth)) / Footprint(ref, truth), 0.25)
+          << "candidate " << i;
+      const double turn = turned_deg(candidates[i], a);
+      if (role == PatchEngine::Role::kOneCellPass) {
+        EXPECT_LT(turn, 1e-3) << "candidate " << i;
+        kept += turn < 1e-3;
+      } else {
+        turned += turn > 0.5;
+      }
+    }
+  }
+  EXPECT_EQ(kept, static_cast<int>(candidates.size()));
+  EXPECT_GE(turned, static_cast<int>(candidates.size()) / 2);
+}
+
 // A large window keeps its extent and loses samples: the fewest odd grid
 // whose spacing stays at most the step asked for; the window size itself and
 // anything smaller sample every pixel.
