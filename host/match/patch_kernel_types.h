@@ -66,6 +66,10 @@ static_assert(sizeof(NccPatch) == 48, "NccPatch must match the kernel's struct")
 static_assert(alignof(NccPatch) == 16, "NccPatch must be float4-aligned");
 static_assert(offsetof(NccPatch, reference) == 32, "NccPatch::reference must follow 2 x float4");
 
+// The number of search directions NccPatch::directions stands for, as
+// kernels/patch_search.cl's search_directions reads it.
+inline int SearchDirections(const NccPatch& patch) { return patch.directions == 2 ? 2 : 6; }
+
 // One (patch, view) pair: scores[i] compares patch `patch` in its reference
 // image with image `view`. view == reference is allowed (the NCC is then 1
 // wherever it is defined).

@@ -100,9 +100,9 @@ std::vector<RefinedPatchReference> PatchRefineReference(const NccGroup& group,
     int halvings = 0;
     int lead = 0;
     r.evaluations = 1;
+    const int directions = SearchDirections(patch);
     for (int it = 0; it < options.iterations && halvings < options.max_halvings; ++it) {
       int moved = -1;
-      const int directions = patch.directions == 2 ? 2 : 6;
       for (int j = 0; j < directions && moved < 0; ++j) {
         const int k = (lead + j) % directions;
         double q[3] = {p[0], p[1], p[2]};
