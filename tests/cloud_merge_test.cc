@@ -153,6 +153,45 @@ TEST(CloudMerge, AnotherGroupsLayerJustOffTheOwnersSurfaceIsNotStacked) {
   EXPECT_EQ(st.kept_by_group[1], static_cast<long>(b.points.size()));
 }
 
+TEST(CloudMerge, AnotherGroupsSurfaceAboveTheOwnersAlongItsNormalIsNotStacked) {
+  // b placed a's ground (a crown, a hedge) 2.5 radii higher, a little
+  // aside: farther than outside_core_radii from every point of a, but
+  // within that of the line along its normal. Where a has a hole, b fills it.
+  const double s = 0.5;
+  PointCloud a = Grid(0, 10, 0, 10, s, 0, 0, 100, 0.5f);
+  a.points.erase(std::remove_if(a.points.begin(), a.points.end(),
+                                [](const CloudPoint& p) { return p.position.x() >= 500006.0; }),
+                 a.points.end());
+  PointCloud b = Grid(0, 10, 0, 10, s, s / 2, s / 2, 100 + 2.5 * s, 0.9f);
+  for (PointCloud* c : {&a, &b}) {
+    c->has_normals = true;
+    for (CloudPoint& p : c->points) p.normal = Eigen::Vector3f::UnitZ();
+  }
+  std::vector<GroupCloud> groups = {{&a, {500005.0, 5400005.0}}, {&b, {500040.0, 5400005.0}}};
+  MergeOptions o;
+  o.radius = s;
+  o.outside_core_radii = 1.5;
+  auto kept_b = [&](double x0, double x1) {
+    long n = 0;
+    for (const MergedRef& r : MergeGroupRefs(groups, o)) {
+      const double x = groups[r.group].cloud->points[r.index].position.x();
+      n += r.group == 1 && x >= x0 && x < x1;
+    }
+    return n;
+  };
+  // b's columns over a's ground (x 0.25 to 5.25) and over the hole, beyond
+  // 1.5 radii of a's last column (6.75 to 9.75), 20 points each.
+  const long b_over_a = 11 * 20, b_in_hole = 7 * 20;
+  EXPECT_EQ(kept_b(500000.0, 500005.5), 0);
+  EXPECT_EQ(kept_b(500006.5, 500010.5), b_in_hole);
+  // Judged by the sphere alone, the layer stays; so it does without normals.
+  o.surface_depth_radii = 0;
+  EXPECT_EQ(kept_b(500000.0, 500005.5), b_over_a);
+  o.surface_depth_radii = 10;
+  for (CloudPoint& p : b.points) p.normal = Eigen::Vector3f::Zero();
+  EXPECT_EQ(kept_b(500000.0, 500005.5), b_over_a);
+}
+
 TEST(CloudMerge, BothGroupsAreKeptWithinTheBlendBandOfTheirBorder) {
   // Both groups matched all of [0, 20) x [0, 10), a little apart as with
   // real orientations; their cores meet at x = 10.
@@ -221,7 +260,8 @@ TEST(CloudMerge, SameInputsGiveTheSameOutput) {
 
 // The merge keeps, in order of core first and then score, each point with
 // no kept point of another group within the radius (outside_core_radii
-// radii for a point outside its core). Checked pair by pair
+// radii for a point outside its core, of the line along its normal where it
+// has one, and surface_depth_radii along it). Checked pair by pair
 // against every kept point on three groups: two that overlap in a band and
 // one apart, whose points the merge keeps without looking them up.
 TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
@@ -235,6 +275,8 @@ TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
       const double x = boxes[g][0] + (boxes[g][1] - boxes[g][0]) * u(rng);
       p.position = {500000.0 + x, 5400000.0 + 10 * u(rng), 0.2 * u(rng)};
       p.score = static_cast<float>(u(rng));
+      // Every other point with a steep normal (a wall), the others without.
+      if (i % 2 == 0) p.normal = Eigen::Vector3f(1.0f, 0.2f, 0.4f).normalized();
       clouds[g].points.push_back(p);
     }
   }
@@ -243,8 +285,9 @@ TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
     groups.push_back({&clouds[g], {500000.0 + 0.5 * (boxes[g][0] + boxes[g][1]), 5400005.0}});
   }
   MergeOptions o;
-  o.radius = 0.3;
+  o.radius = 0.15;
   o.outside_core_radii = 2.5;
+  o.surface_depth_radii = 4;
   MergeStats stats;
   const std::vector<MergedRef> merged = MergeGroupRefs(groups, o, &stats);
 
@@ -270,9 +313,14 @@ TEST(CloudMerge, KeepsWhatTheGreedyPassOverAllPairsKeeps) {
   for (const Item& item : items) {
     const Eigen::Vector3d& p = clouds[item.group].points[item.index].position;
     const double r = item.core ? o.radius : o.radius * o.outside_core_radii;
+    const Eigen::Vector3d n = clouds[item.group].points[item.index].normal.cast<double>();
+    const bool cylinder = !item.core && n.squaredNorm() > 0;
     const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Item& k) {
-      return k.group != item.group &&
-             (clouds[k.group].points[k.index].position - p).squaredNorm() <= r * r;
+      const Eigen::Vector3d d = clouds[k.group].points[k.index].position - p;
+      if (k.group == item.group) return false;
+      if (!cylinder) return d.squaredNorm() <= r * r;
+      return std::abs(d.dot(n)) <= o.radius * o.surface_depth_radii &&
+             d.squaredNorm() - d.dot(n) * d.dot(n) <= r * r;
     });
     if (!duplicate) kept.push_back(item);
   }

@@ -68,6 +68,24 @@ TEST(SeamLeveling, EachStretchOfABorderHasItsOwnOffset) {
   EXPECT_NEAR(s.Correction(0, {kSeamX0, kSeamY0 + 1, 50}), -0.015, 0.003);
 }
 
+TEST(SeamLeveling, EachCellOfTheBandMeetsTheOtherGroupsSurface) {
+  // Group 1 places a hedge 4 cm higher along 0.6 of the border, 3 of the
+  // 10 rows of cells of its stretch, whose median offset is then none.
+  SeamLeveling s(kSeamCenters, SeamTestOptions());
+  AddGroup(&s, 0, -8, 0.4, [](double, double) { return 20.0; });
+  AddGroup(&s, 1, -0.4, 8, [](double, double y) { return y >= 0 && y < 0.6 ? 20.04 : 20.0; });
+  s.Finish();
+  // At the border the two meet halfway; across the band (0.5) it fades out.
+  EXPECT_NEAR(s.Correction(0, {kSeamX0, kSeamY0 + 0.3, 20.0}), 0.02, 0.003);
+  EXPECT_NEAR(s.Correction(1, {kSeamX0, kSeamY0 + 0.3, 20.04}), -0.02, 0.003);
+  EXPECT_NEAR(s.Correction(0, {kSeamX0 - 0.3, kSeamY0 + 0.3, 20.0}), 0.008, 0.002);
+  // Beyond the band only the stretch's own (none) is left, as beside it.
+  EXPECT_DOUBLE_EQ(s.Correction(0, {kSeamX0 - 0.6, kSeamY0 + 0.3, 20.0}),
+                   s.Correction(0, {kSeamX0 - 0.6, kSeamY0 + 1.5, 20.0}));
+  // Beside the hedge nothing moves.
+  EXPECT_NEAR(s.Correction(0, {kSeamX0, kSeamY0 + 1.5, 20.0}), 0, 0.003);
+}
+
 TEST(SeamLeveling, OffsetsBeyondTheLargestAreSurfacesNotOrientations) {
   // A roof 3 m high on group 1's side of the south half: its band there
   // compares the roof with group 0's ground, and is left alone.

@@ -142,6 +142,9 @@ TEST(TiledMergeTest, ManyTilesDifferOnlyNearBorders) {
   // cores that are judged at 3.
   o.outside_core_radii = 3;
   o.halo_radii = 8.0 / 3;
+  // A cylinder along the normals that this halo covers twice (the default's
+  // would widen the halo, and the tiles with it).
+  o.surface_depth_radii = 2;
   MergeStats global_stats, tiled_stats;
   MergeLayout layout;
   const PointCloud global = GlobalMerge(b, o, &global_stats);

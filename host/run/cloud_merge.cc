@@ -37,6 +37,11 @@ std::string MergeOptions::Problem() const {
     s << "a blend band >= 0 radii (blend_radii = " << blend_radii << ")";
     return s.str();
   }
+  if (!(std::isfinite(surface_depth_radii) && surface_depth_radii >= 0)) {
+    std::ostringstream s;
+    s << "a surface depth >= 0 radii (surface_depth_radii = " << surface_depth_radii << ")";
+    return s.str();
+  }
   if (tile_points < 1000)
     return "merge tile points >= 1000 (tile_points = " + std::to_string(tile_points) + ")";
   if (!(std::isfinite(halo_radii) && halo_radii >= 1)) {
@@ -228,7 +233,13 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   const double blend_width = options.radius * options.blend_radii;
   std::optional<CoreIndex> own_cores;
   if (!cores) cores = &own_cores.emplace(centers, blend_width);
+  // A point outside its core is judged within `wide` of its normal line and
+  // `deep` along it: the corners of that cylinder are `reach` away.
+  const double deep = options.radius * options.surface_depth_radii;
+  const double reach = std::max(wide, std::hypot(wide, deep));
   const std::vector<uint8_t> contested = MayHaveForeignNeighbour(groups, wide);
+  const std::vector<uint8_t> contested_far =
+      reach > wide ? MayHaveForeignNeighbour(groups, reach) : contested;
   std::vector<Item> items(contested.size());
   size_t flat = 0;
   for (size_t g = 0; g < groups.size(); ++g) {
@@ -244,7 +255,7 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
       const bool core = owner == static_cast<int>(g);
       items[flat + i] = {{static_cast<int>(g), i},
                          core,
-                         contested[flat + i] != 0,
+                         (core ? contested : contested_far)[flat + i] != 0,
                          border < blend_width,
                          pts[i].score};
     }
@@ -261,15 +272,23 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   };
   // Core points are looked up within the radius, the others within `wide`,
   // each in a grid of its own reach (RadiusGrid looks one cube around).
-  RadiusGrid<Ref> kept(options.radius), kept_wide(wide);
+  RadiusGrid<Ref> kept(options.radius), kept_wide(reach);
   for (const Item& item : items) {
     if (item.contested) {
       const Eigen::Vector3d& p = point(item.ref).position;
       const double r = item.core ? options.radius : wide;
       const double r2 = r * r;
+      // Outside its core, the cylinder along the point's normal where it
+      // has one (a zero normal: unknown), else the sphere.
+      const Eigen::Vector3d n = point(item.ref).normal.cast<double>();
+      const bool cylinder = !item.core && reach > wide && n.squaredNorm() > 0.5;
       const bool duplicate =
           !item.blend && (item.core ? kept : kept_wide).AnyNear(p, [&](const Ref& other) {
-            return other.group != item.ref.group && (point(other).position - p).squaredNorm() <= r2;
+            if (other.group == item.ref.group) return false;
+            const Eigen::Vector3d d = point(other).position - p;
+            if (!cylinder) return d.squaredNorm() <= r2;
+            const double along = d.dot(n);
+            return std::abs(along) <= deep && d.squaredNorm() - along * along <= r2;
           });
       if (duplicate) {
         ++st.duplicates;

@@ -112,8 +112,11 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
     if (layout_out) *layout_out = layout;
     return st;
   }
-  // In the radii a point outside its core is judged by.
-  const double halo = options.halo_radii * options.radius * options.outside_core_radii;
+  // In the radii a point outside its core is judged by, and at least twice
+  // the reach of the cylinder along its normal (cloud_merge.h).
+  const double halo = options.radius * std::max(options.halo_radii * options.outside_core_radii,
+                                                2 * std::hypot(options.outside_core_radii,
+                                                               options.surface_depth_radii));
   layout.tiles_x = layout.tiles_y = 1;
   if (layout.input_points > options.tile_points) {
     // Square tiles of about tile_points each at the block's mean density,
