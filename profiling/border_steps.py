@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""Steps between neighbouring DSM cells of a grouped run, by distance to a border.
+
+group_borders splits the pairs of neighbouring cells of a run's dsm.tif into
+"inside groups" and "across borders". This splits those inside groups further
+by how far (in cells) they lie from the nearest border between two group
+cores, which shows whether the pairs by a border are rougher than those deep
+in a group, and repeats the split for open ground only: cells within 1 unit
+of the 5th percentile height of the 31 x 31 cells around (no crowns, no
+roofs), where steps are the surface's and not the scene's.
+
+    python3 profiling/border_steps.py RUN_DIR
+
+Needs python3-numpy and gdal-bin (gdal_translate, gdalinfo) from Debian.
+Prints count, median, p90 and p99 of |dz| per set, in CRS units.
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import warnings
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+
+def read_dsm(path):
+    info = subprocess.run(["gdalinfo", path], capture_output=True, text=True, check=True).stdout
+    w, h = map(int, re.search(r"Size is (\d+), (\d+)", info).groups())
+    ox, oy = map(float, re.search(r"Origin = \(([-\d.e]+),([-\d.e]+)\)", info).groups())
+    cell = float(re.search(r"Pixel Size = \(([-\d.e]+),", info).group(1))
+    with tempfile.TemporaryDirectory() as tmp:
+        raw = os.path.join(tmp, "dsm.bin")
+        subprocess.run(["gdal_translate", "-q", "-ot", "Float32", "-of", "ENVI", path, raw],
+                       check=True)
+        z = np.fromfile(raw, dtype=np.float32).reshape(h, w)
+    nodata = re.search(r"NoData Value=([-\w.e+]+)", info)
+    empty = ~np.isfinite(z)
+    if nodata and nodata.group(1).lower() != "nan":
+        empty |= z == float(nodata.group(1))
+    return z, empty, ox, oy, cell
+
+
+def quantiles(v):
+    if len(v) == 0:
+        return "%9d %9s %9s %9s" % (0, "-", "-", "-")
+    return "%9d %9.4f %9.4f %9.4f" % (len(v), *np.quantile(v, [0.5, 0.9, 0.99]))
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit("usage: border_steps.py RUN_DIR")
+    run = sys.argv[1]
+    z, empty, ox, oy, cell = read_dsm(os.path.join(run, "dsm.tif"))
+    h, w = z.shape
+    with open(os.path.join(run, "report.json")) as f:
+        centers = np.array([g["center"] for g in json.load(f)["groups"]], dtype=float)
+    if len(centers) < 2:
+        sys.exit("%s: one group, no borders" % run)
+    ys, xs = np.mgrid[0:h, 0:w]
+    cx = ox + (xs + 0.5) * cell
+    cy = oy - (ys + 0.5) * cell
+    d2 = np.stack([(cx - c[0]) ** 2 + (cy - c[1]) ** 2 for c in centers])
+    nearest = np.argsort(d2, axis=0)[:2]
+    owner = nearest[0]
+    first = np.take_along_axis(d2, nearest[:1], 0)[0]
+    second = np.take_along_axis(d2, nearest[1:2], 0)[0]
+    apart = np.linalg.norm(centers[nearest[0]] - centers[nearest[1]], axis=-1)
+    # Distance to the bisector of the two nearest centres, in cells.
+    border = (second - first) / (2 * apart) / cell
+
+    k = 15
+    padded = np.pad(np.where(empty, np.nan, z), k, constant_values=np.nan)
+    low = np.full(z.shape, np.nan)
+    for r0 in range(0, h, 64):
+        win = sliding_window_view(padded[r0:r0 + 64 + 2 * k], (2 * k + 1, 2 * k + 1))[:, :w]
+        # Windows with no filled cell: no low, no open ground there.
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            low[r0:r0 + win.shape[0]] = np.nanpercentile(
+                win.reshape(win.shape[0], win.shape[1], -1), 5, axis=2)
+    with np.errstate(invalid="ignore"):
+        open_ground = (z - low) < 1.0
+
+    dz, same, dist, both_open = [], [], [], []
+    for dr, dc in ((0, 1), (1, 0)):
+        a = (slice(0, h - dr), slice(0, w - dc))
+        b = (slice(dr, h), slice(dc, w))
+        ok = ~empty[a] & ~empty[b]
+        dz.append(np.abs(z[a] - z[b])[ok])
+        same.append((owner[a] == owner[b])[ok])
+        dist.append(np.minimum(border[a], border[b])[ok])
+        both_open.append((open_ground[a] & open_ground[b])[ok])
+    dz, same, dist, both_open = map(np.concatenate, (dz, same, dist, both_open))
+
+    print("DSM steps (cell %g): neighbouring cells' |dz|" % cell)
+    print("%-28s %9s %9s %9s %9s" % ("pairs", "count", "median", "p90", "p99"))
+    for name, sel in (("", np.ones_like(same)), ("open ground: ", both_open)):
+        print("%-28s %s" % (name + "across borders", quantiles(dz[sel & ~same])))
+        print("%-28s %s" % (name + "inside groups", quantiles(dz[sel & same])))
+        if name:
+            continue
+        for lo, hi in ((0, 2), (2, 5), (5, 10), (10, 20), (20, None)):
+            m = sel & same & (dist >= lo) & ((dist < hi) if hi else True)
+            label = "  %g-%s cells from a border" % (lo, hi if hi else "")
+            print("%-28s %s" % (label, quantiles(dz[m])))
+
+
+if __name__ == "__main__":
+    main()
