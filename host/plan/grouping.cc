@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
@@ -240,6 +241,60 @@ void CheckTileCost(const Block& block, const GroupingOptions& o, const std::vect
   }
 }
 
+// A group of fewer than `smallest` images (a corner of the block that few
+// photos see: on the Caliterra flight a tile that 2 of its 75 photos reach)
+// is matched by its neighbours when they can: its ground goes, as the merge
+// gives it, to the nearest other centres, and each of the groups it goes to
+// must hold all of its images and still fit with its tile grown over it.
+// Centres stay where they are, so no other ground changes hands.
+void AbsorbSmallGroups(const Block& block, const std::vector<Footprint>& fp, size_t smallest,
+                       GroupingPlan* plan) {
+  for (size_t k = 0; k < plan->groups.size();) {
+    const ImageGroup& small = plan->groups[k];
+    if (small.images.size() >= smallest || plan->groups.size() < 2) {
+      ++k;
+      continue;
+    }
+    std::vector<int> mine = small.images;
+    std::sort(mine.begin(), mine.end());
+    // Who takes each sample of the tile, and the tiles grown to hold them.
+    std::map<size_t, ImageGroup> grown;
+    bool can = true;
+    for (int sy = 0; sy < kTileSamples && can; ++sy) {
+      for (int sx = 0; sx < kTileSamples && can; ++sx) {
+        const Eigen::Vector2d p =
+            small.tile_min + Eigen::Vector2d((sx + 0.5) / kTileSamples, (sy + 0.5) / kTileSamples)
+                                 .cwiseProduct(small.tile_max - small.tile_min);
+        size_t to = k;
+        for (size_t j = 0; j < plan->groups.size(); ++j) {
+          if (j != k && (to == k || (plan->groups[j].center - p).squaredNorm() <
+                                        (plan->groups[to].center - p).squaredNorm()))
+            to = j;
+        }
+        auto it = grown.find(to);
+        if (it == grown.end()) {
+          std::vector<int> theirs = plan->groups[to].images;
+          std::sort(theirs.begin(), theirs.end());
+          can = std::includes(theirs.begin(), theirs.end(), mine.begin(), mine.end());
+          it = grown.emplace(to, plan->groups[to]).first;
+        }
+        it->second.tile_min = it->second.tile_min.cwiseMin(p);
+        it->second.tile_max = it->second.tile_max.cwiseMax(p);
+      }
+    }
+    for (const auto& [j, g] : grown) can = can && Fits(block, g, fp, *plan);
+    if (!can) {
+      ++k;
+      continue;
+    }
+    for (const auto& [j, g] : grown) {
+      plan->groups[j].tile_min = g.tile_min;
+      plan->groups[j].tile_max = g.tile_max;
+    }
+    plan->groups.erase(plan->groups.begin() + static_cast<long>(k));
+  }
+}
+
 void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeometry& geometry,
                    const std::vector<Footprint>& fp, GroupingPlan* plan) {
   if (!geometry.aerial) {
@@ -377,6 +432,7 @@ void PlanFootprint(const Block& block, const GroupingOptions& o, const BlockGeom
       tiles_in_group.push_back(1);
     }
   }
+  AbsorbSmallGroups(block, fp, std::min<size_t>(kSmallestGroup, o.max_images), plan);
   // An image no tile chose (its ground better seen by others, or no ground
   // at all) still joins the group that sees it best, so that no image is
   // left out of the plan.
