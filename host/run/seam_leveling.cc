@@ -69,12 +69,15 @@ void SeamLeveling::Add(int g, const Eigen::Vector3d& p) {
 void SeamLeveling::Finish() {
   std::map<std::tuple<int, int, int64_t, int64_t>, std::vector<double>> stretches;
   std::map<std::pair<int, int>, std::vector<double>> pairs;
+  // Each cell's offset z_a - z_b, where both groups have points in it.
+  std::map<std::tuple<int, int, int64_t, int64_t>, double> cell_d;
   for (auto it = heights_.begin(); it != heights_.end(); ++it) {
     const auto& [a, b, x, y, side] = it->first;
     if (side != 0) continue;
     const auto other = heights_.find({a, b, x, y, 1});
     if (other == heights_.end()) continue;
     const double d = Median(it->second) - Median(other->second);
+    cell_d[{a, b, x, y}] = d;
     // The cell's centre names the stretch it lies in.
     const double cx = (x + 0.5) * options_.cell, cy = (y + 0.5) * options_.cell;
     stretches[{a, b, Floor(cx, options_.feather), Floor(cy, options_.feather)}].push_back(d);
@@ -83,13 +86,6 @@ void SeamLeveling::Finish() {
   // Per cell, what the stretch's median leaves: the offset of the 3 x 3
   // cells around (their median, from 3 cells on), so that the two surfaces
   // meet cell by cell and not only on the stretch's average.
-  std::map<std::tuple<int, int, int64_t, int64_t>, double> cell_d;
-  for (auto it = heights_.begin(); it != heights_.end(); ++it) {
-    const auto& [a, b, x, y, side] = it->first;
-    if (side != 0) continue;
-    const auto other = heights_.find({a, b, x, y, 1});
-    if (other != heights_.end()) cell_d[{a, b, x, y}] = Median(it->second) - Median(other->second);
-  }
   for (const auto& [key, unused] : cell_d) {
     const auto& [a, b, x, y] = key;
     std::vector<double> ds;
