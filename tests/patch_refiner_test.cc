@@ -172,8 +172,7 @@ TEST_P(PatchRefinerTest, ConvergesToThePlaneAndMatchesReference) {
   double worst_angle = 0.0;
   double lowest_score = 1.0;
   for (size_t i = 0; i < refined.size(); ++i) {
-    const Eigen::Vector3d c(refined[i].patch.center.s[0], refined[i].patch.center.s[1],
-                            refined[i].patch.center.s[2]);
+    const Eigen::Vector3d c = Xyz(refined[i].patch.center);
     const Eigen::Vector3d n(refined[i].patch.normal.s[0], refined[i].patch.normal.s[1],
                             refined[i].patch.normal.s[2]);
     const double depth_error = DepthErrorFootprints(ref, c);
@@ -260,8 +259,7 @@ TEST_P(PatchRefinerTest, StopsAfterMaxHalvings) {
     EXPECT_LT(once[i].moves, options.iterations);
     EXPECT_LE(once[i].moves, converged[i].moves);
     fewer += once[i].moves < converged[i].moves;
-    const Eigen::Vector3d center(converged[i].patch.center.s[0], converged[i].patch.center.s[1],
-                                 converged[i].patch.center.s[2]);
+    const Eigen::Vector3d center = Xyz(converged[i].patch.center);
     EXPECT_LT(DepthErrorFootprints(scene.cameras[0], center), 0.5) << "patch " << i;
   }
   // Stopping at the first failed round must cut some searches short.
@@ -289,8 +287,7 @@ TEST_P(PatchRefinerTest, DepthOnlyKeepsTheNormalAndFindsTheDepth) {
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(depth_only[i].patch.normal.s[k], patches[i].normal.s[k], 1e-6) << "patch " << i;
     }
-    const Eigen::Vector3d c(depth_only[i].patch.center.s[0], depth_only[i].patch.center.s[1],
-                            depth_only[i].patch.center.s[2]);
+    const Eigen::Vector3d c = Xyz(depth_only[i].patch.center);
     EXPECT_LT(DepthErrorFootprints(scene.cameras[0], c), 0.25) << "patch " << i;
     full_scores += full[i].evaluations;
     depth_scores += depth_only[i].evaluations;
@@ -324,7 +321,7 @@ TEST_P(PatchRefinerTest, WeightedNccMatchesReferenceAndConverges) {
   const Camera& ref = scene.cameras[0];
   for (size_t i = 0; i < refined.size(); ++i) {
     const RefinedPatch& r = refined[i];
-    const Eigen::Vector3d center(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
+    const Eigen::Vector3d center = Xyz(r.patch.center);
     const double depth_error = DepthErrorFootprints(ref, center);
     std::printf("[ REFINE   ] weighted patch %zu: depth error %.3f footprints, score %.4f\n", i,
                 depth_error, r.score);
@@ -367,7 +364,7 @@ TEST_P(PatchRefinerTest, StaysWithinMaxAngleOfTheReferenceRay) {
     // A window without texture in some view scores NaN wherever it turns.
     if (!std::isfinite(r.score)) continue;
     ++scored;
-    const Eigen::Vector3d center(r.patch.center.s[0], r.patch.center.s[1], r.patch.center.s[2]);
+    const Eigen::Vector3d center = Xyz(r.patch.center);
     const Eigen::Vector3d normal(r.patch.normal.s[0], r.patch.normal.s[1], r.patch.normal.s[2]);
     const double angle = AngleDeg(normal, ref.center() - center);
     widest = std::max(widest, angle);
