@@ -321,6 +321,37 @@ TEST(SelectViewsTest, OwnImagesComeBeforeViewOnlyOnes) {
   }
 }
 
+// Where the group's own images meet too narrowly, a view-only image that
+// widens the angle joins a patch's views, even when the reference's list
+// (SelectViews) is full of its own: ten images 1.35 degrees apart along a
+// strip, the eight own ones spanning 9.45 degrees (under max_angle), the
+// two view-only ones at either end 10.8. Image 0's seven views are all its
+// own, so without the view-only ones no patch of it is wide enough.
+TEST_F(PatchEngineTest, AViewOnlyImageWidensWhereTheOwnImagesMeetTooNarrowly) {
+  const double base = 40.0 * std::tan(1.35 * kPiRad / 180.0);
+  const PlaneScene strip = MakePlaneScene(10, 201, 161, 96, base);
+  MatchGroupData group = test::MatchGroupOf(strip);
+  for (MatchImage& im : group.images) im.depth = 40.0;
+  group.images[8].reference = group.images[9].reference = false;
+  MatcherOptions options;
+  ASSERT_EQ(options.max_angle_deg, 10.0);
+  SelectViews(options, &group);
+  ASSERT_EQ(group.images[0].views.size(), static_cast<size_t>(kMaxViews - 1));
+  for (const int v : group.images[0].views) ASSERT_TRUE(group.images[v].reference) << v;
+  PatchEngine engine(NewKernels(), group, options);
+  int accepted = 0;
+  for (const auto& r : engine.Evaluate(TiltedSeeds(strip, 8, 0.0, 0.0, 97))) {
+    if (!r) continue;
+    ++accepted;
+    EXPECT_TRUE(std::any_of(r->views.begin(), r->views.end(), [](int v) { return v >= 8; }));
+    EXPECT_LE(r->views.size(), static_cast<size_t>(kMaxViews - 1));
+    const Camera& ref = strip.cameras[0];
+    const Eigen::Vector3d truth = GroundAt(ref, ref.Project(r->center));
+    EXPECT_LT(std::abs(ref.Depth(r->center) - ref.Depth(truth)) / Footprint(ref, truth), 0.5);
+  }
+  EXPECT_EQ(accepted, 8);
+}
+
 // The paper's narrow baselines: 5 images 4 degrees apart along a strip
 // (2.8 m at 40 m). Every view of the middle image is narrower than
 // max_angle (10 degrees), yet the views on either side of it are 12 to 16

@@ -204,14 +204,15 @@ bool PatchEngine::OnParentPlane(const PatchCandidate& candidate,
 std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
                                            const Eigen::Vector3d& normal, int ref, int half) const {
   const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
+  auto sees = [&](int v) {
+    const Camera& cam = group_.images[v].camera;
+    if (!(cam.Depth(center) > 0)) return false;
+    if (!cam.InImage(cam.Project(center), half + 1)) return false;
+    return normal.dot((cam.center() - center).normalized()) >= cos_max;
+  };
   std::vector<int> views, view_only;
   for (const int v : group_.images[ref].views) {
-    const Camera& cam = group_.images[v].camera;
-    if (!(cam.Depth(center) > 0)) continue;
-    if (!cam.InImage(cam.Project(center), half + 1)) continue;
-    const Eigen::Vector3d to_cam = (cam.center() - center).normalized();
-    if (normal.dot(to_cam) < cos_max) continue;
-    (group_.images[v].reference ? views : view_only).push_back(v);
+    if (sees(v)) (group_.images[v].reference ? views : view_only).push_back(v);
   }
   // Another strip's images only to bring the group's own up to
   // min_image_num, best first: at campus's 92 % forward overlap all of them
@@ -220,6 +221,36 @@ std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
   for (const int v : view_only) {
     if (static_cast<int>(views.size()) >= options_.min_image_num) break;
     views.push_back(v);
+  }
+  // And one to widen the angle where the group's images meet too narrowly,
+  // from all its view-only images (the reference's own may fill its list):
+  // at a turn, where the drone slowed, the four images of one group that
+  // saw an 18 x 5 m wedge of road on the Caliterra flight met at 9.6
+  // degrees at most, and PMVS2, which matches with all images, covered it.
+  if (static_cast<int>(views.size()) >= options_.min_image_num - 1 &&
+      !WideEnough(center, ref, views)) {
+    for (size_t v = 0; v < group_.images.size(); ++v) {
+      const int w = static_cast<int>(v);
+      if (group_.images[v].reference || w == ref ||
+          std::find(views.begin(), views.end(), w) != views.end() || !sees(w)) {
+        continue;
+      }
+      // The list is as long as the kernels take: the least overlapping own
+      // view makes room.
+      const bool full = static_cast<int>(views.size()) >= kMaxViews - 1;
+      const int dropped = full ? views.back() : -1;
+      if (full) {
+        views.back() = w;
+      } else {
+        views.push_back(w);
+      }
+      if (WideEnough(center, ref, views)) break;
+      if (full) {
+        views.back() = dropped;
+      } else {
+        views.pop_back();
+      }
+    }
   }
   return views;
 }
