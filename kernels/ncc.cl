@@ -10,6 +10,7 @@
 //   PATCH_SIZE        μ, samples per side of the patch grid (odd).
 //   NCC_MIN_VARIANCE  smallest per-sample variance of a sample vector.
 //   NCC_SIGMA_COLOR   > 0 weights the NCC samples (ncc_weights); 0 = plain NCC.
+//   NCC_WEIGHT_MIN_SPREAD  smallest centre spread the weights scale from.
 //   SAMPLE_STEP       spacing of the grid's samples, in reference pixels.
 
 #ifndef SAPMVS_NCC_CL
@@ -23,6 +24,9 @@
 #endif
 #ifndef NCC_SIGMA_COLOR
 #define NCC_SIGMA_COLOR 0.0f
+#endif
+#ifndef NCC_WEIGHT_MIN_SPREAD
+#define NCC_WEIGHT_MIN_SPREAD 2.0f
 #endif
 #ifndef SAMPLE_STEP
 #define SAMPLE_STEP 1.0f
@@ -375,7 +379,8 @@ float ncc_of(float* a, const float* b, const float* w) {
 // The scale s of the sample weights: NCC_SIGMA_COLOR standard deviations of
 // the 3 x 3 samples `nine` around a window's centre, row by row. Their spread
 // is the texture of the centre's surface, not inflated by another surface
-// further out.
+// further out; at least NCC_WEIGHT_MIN_SPREAD, as on weak texture it is the
+// images' noise.
 float ncc_weight_scale(const float* nine) {
   float mean = 0.0f;
   for (int k = 0; k < 9; ++k) {
@@ -387,7 +392,7 @@ float ncc_weight_scale(const float* nine) {
     const float d = nine[k] - mean;
     var += d * d;
   }
-  return NCC_SIGMA_COLOR * sqrt(var / 9.0f);
+  return NCC_SIGMA_COLOR * fmax(sqrt(var / 9.0f), NCC_WEIGHT_MIN_SPREAD);
 }
 
 // The weight of reference sample `a` of a window whose centre sample is

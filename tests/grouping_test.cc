@@ -513,7 +513,9 @@ TEST(GroupingFootprint, NoSmallGroupWhoseNeighboursCanTakeItsGround) {
       EXPECT_TRUE(lacking) << preset << ": a group of " << g.images.size()
                            << " images whose neighbours hold them all";
     }
-    if (std::string(preset) == "small") EXPECT_GT(small, 0) << "no sliver to test on";
+    if (std::string(preset) == "small") {
+      EXPECT_GT(small, 0) << "no sliver to test on";
+    }
   }
 }
 

@@ -28,6 +28,7 @@ BuildOptions NccBuildOptions(int patch_size, int work_group_size, double sigma_c
   BuildOptions defines;
   defines.Define("NCC_MIN_VARIANCE", kNccMinVariance)
       .Define("NCC_SIGMA_COLOR", static_cast<float>(sigma_color))
+      .Define("NCC_WEIGHT_MIN_SPREAD", kNccWeightMinSpread)
       .Define("PATCH_SIZE", patch_size)
       .Define("SAMPLE_STEP", static_cast<float>(sample_step))
       .Define("WORK_GROUP_SIZE", work_group_size);

@@ -32,7 +32,7 @@ double NccWeightScale(const double* values, int n, double sigma) {
   for (int k = 0; k < n; ++k) mean += values[k];
   mean /= n;
   for (int k = 0; k < n; ++k) var += std::pow(values[k] - mean, 2);
-  return sigma * std::sqrt(var / n);
+  return sigma * std::max(std::sqrt(var / n), static_cast<double>(kNccWeightMinSpread));
 }
 
 double NccScoreReferenceUnchecked(const NccGroup& group, const NccPatch& patch, int view,

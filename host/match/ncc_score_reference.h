@@ -14,7 +14,7 @@ namespace sapmvs {
 // The scale s of the weighted NCC's sample weights exp(-d^2 / 2 s^2), as
 // ncc_weights in ncc.cl: `sigma` standard deviations of the `n` samples
 // `values` around the window's centre (its 3 x 3; fewer where an image's
-// border clips them). 0 for a flat centre.
+// border clips them), their spread taken as at least kNccWeightMinSpread.
 double NccWeightScale(const double* values, int n, double sigma);
 
 // scores[i] = NCC of pairs[i], NaN where undefined. Validates the options,
