@@ -81,10 +81,12 @@ struct MatcherOptions {
   // samples around the centre, so that a window straddling a wall, a roof
   // edge or a crown scores the surface under its centre rather than failing
   // or settling on a depth between the two. Relative, so one value suits
-  // scans and renderings of any contrast; smaller is sharper at edges but
-  // noisier on weak texture (on `small` with 4 features per block, 1.5:
-  // 73.0 % coverage; 3: 72.4 %; NGI keeps 87 % of its points at 3, 76 % at
-  // 2). 0 = plain NCC; pmvs mode always scores plain NCC, as PMVS does.
+  // scans and renderings of any contrast (from a spread of at least
+  // kNccWeightMinSpread: weak texture scores as plain NCC); smaller is
+  // sharper at edges but noisier on weak texture (on `small` with 4
+  // features per block, 1.5: 73.0 % coverage; 3: 72.4 %; NGI keeps 87 % of
+  // its points at 3, 76 % at 2). 0 = plain NCC; pmvs mode always scores
+  // plain NCC, as PMVS does.
   double ncc_sigma_color = 3.0;
   // sapmvs: a pixel of an accepted window gets a point only where the
   // weighted NCC gave it at least this weight (ncc_sigma_color), so that a
