@@ -129,6 +129,9 @@ PatchEngine::PatchEngine(PatchKernels& kernels, const MatchGroupData& group,
       expansion_options_(ExpansionOptionsOf(options, role)),
       polish_options_(PolishOptionsOf(options)) {
   kernels_.SetGroup(group_.ncc);
+  for (size_t i = 0; i < group_.images.size(); ++i) {
+    if (!group_.images[i].reference) view_only_images_.push_back(static_cast<int>(i));
+  }
 }
 
 PatchEngine::~PatchEngine() { kernels_.ClearGroup(); }
@@ -227,30 +230,21 @@ std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
   // at a turn, where the drone slowed, the four images of one group that
   // saw an 18 x 5 m wedge of road on the Caliterra flight met at 9.6
   // degrees at most, and PMVS2, which matches with all images, covered it.
-  if (static_cast<int>(views.size()) >= options_.min_image_num - 1 &&
+  if (!view_only_images_.empty() && static_cast<int>(views.size()) >= options_.min_image_num - 1 &&
       !WideEnough(center, ref, views)) {
-    for (size_t v = 0; v < group_.images.size(); ++v) {
-      const int w = static_cast<int>(v);
-      if (group_.images[v].reference || w == ref ||
-          std::find(views.begin(), views.end(), w) != views.end() || !sees(w)) {
-        continue;
-      }
-      // The list is as long as the kernels take: the least overlapping own
-      // view makes room.
-      const bool full = static_cast<int>(views.size()) >= kMaxViews - 1;
-      const int dropped = full ? views.back() : -1;
-      if (full) {
-        views.back() = w;
-      } else {
-        views.push_back(w);
-      }
-      if (WideEnough(center, ref, views)) break;
-      if (full) {
-        views.back() = dropped;
-      } else {
-        views.pop_back();
-      }
+    // The list is as long as the kernels take: the least overlapping own
+    // view makes room, and comes back if no image widens the angle.
+    const int dropped = static_cast<int>(views.size()) >= kMaxViews - 1 ? views.back() : -1;
+    if (dropped >= 0) views.pop_back();
+    bool widened = false;
+    for (const int w : view_only_images_) {
+      if (std::find(views.begin(), views.end(), w) != views.end() || !sees(w)) continue;
+      views.push_back(w);
+      widened = WideEnough(center, ref, views);
+      if (widened) break;
+      views.pop_back();
     }
+    if (!widened && dropped >= 0) views.push_back(dropped);
   }
   return views;
 }

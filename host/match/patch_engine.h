@@ -166,6 +166,9 @@ class PatchEngine {
   // For a batch of expansion candidates (kExpansionRefineDepthStep).
   PatchRefinerOptions expansion_options_;
   std::map<int, PatchRefinerOptions> polish_options_;  // by patch side (sapmvs)
+  // The group's view-only images (MatchImage::reference false), which
+  // VisibleViews may add to widen a patch's angle; none in a one-group run.
+  std::vector<int> view_only_images_;
   std::map<std::string, KernelTime> kernel_times_;
   // The halves of Evaluate launch from two threads. launch_mutex_ is held
   // for each launch unless the kernels take concurrent launches (the OpenCL

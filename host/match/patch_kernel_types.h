@@ -127,8 +127,9 @@ struct NccScorerOptions {
   // exp(-d^2 / 2 s^2), d its difference from the centre sample of the
   // reference window and s = sigma_color standard deviations of the 3 x 3
   // reference samples around the centre (the texture of the centre's
-  // surface; at least kNccWeightMinSpread), so that a window straddling two surfaces scores the one
-  // under its centre; 0 = plain NCC (PMVS). Finite, >= 0.
+  // surface; at least kNccWeightMinSpread), so that a window straddling two
+  // surfaces scores the one under its centre; 0 = plain NCC (PMVS). Finite,
+  // >= 0.
   double sigma_color = 0.0;
 
   // Logs the first failing condition to stderr and returns false.
