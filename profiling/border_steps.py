@@ -9,11 +9,18 @@ in a group, and repeats the split for open ground only: cells within 1 unit
 of the 5th percentile height of the 31 x 31 cells around (no crowns, no
 roofs), where steps are the surface's and not the scene's.
 
-    python3 profiling/border_steps.py RUN_DIR
+    python3 profiling/border_steps.py RUN_DIR [--borders-of GROUPED_RUN_DIR]
+
+--borders-of takes the group centres (and so the borders) from another run:
+given a one-group run of the same block (`--max-images` above its image count,
+`--dsm-cell` the grouped run's cell), it measures the same pairs on a surface
+that no border touched, which tells a step the merge made from one the scene
+has where a border happens to lie (a forest edge, a wall).
 
 Needs python3-numpy and gdal-bin (gdal_translate, gdalinfo) from Debian.
 Prints count, median, p90 and p99 of |dz| per set, in CRS units.
 """
+import argparse
 import json
 import os
 import re
@@ -50,15 +57,17 @@ def quantiles(v):
 
 
 def main():
-    if len(sys.argv) != 2:
-        sys.exit("usage: border_steps.py RUN_DIR")
-    run = sys.argv[1]
-    z, empty, ox, oy, cell = read_dsm(os.path.join(run, "dsm.tif"))
+    parser = argparse.ArgumentParser(description="DSM steps by distance to a group border")
+    parser.add_argument("run", help="run folder with dsm.tif and report.json")
+    parser.add_argument("--borders-of", metavar="RUN", help="take the group centres from this run")
+    args = parser.parse_args()
+    z, empty, ox, oy, cell = read_dsm(os.path.join(args.run, "dsm.tif"))
     h, w = z.shape
-    with open(os.path.join(run, "report.json")) as f:
+    grouped = args.borders_of or args.run
+    with open(os.path.join(grouped, "report.json")) as f:
         centers = np.array([g["center"] for g in json.load(f)["groups"]], dtype=float)
     if len(centers) < 2:
-        sys.exit("%s: one group, no borders" % run)
+        sys.exit("%s: one group, no borders" % grouped)
     ys, xs = np.mgrid[0:h, 0:w]
     cx = ox + (xs + 0.5) * cell
     cy = oy - (ys + 0.5) * cell

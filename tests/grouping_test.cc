@@ -377,6 +377,32 @@ TEST(GroupingStrips, LoneImageJoinsTheNearestGroup) {
   EXPECT_EQ(holder, 2);
 }
 
+TEST(GroupingStrips, NoGroupUnderTheSmallestWhileOthersHaveImagesToLend) {
+  // A strip of 7 at 6 per group: 6 + 1 cannot move its cuts back to 4 + 4,
+  // and the run left (5 + 3, sharing one) is under the paper's smallest.
+  SimBlock s = MakeSimBlock("campus", false, {0});
+  s.block.images.resize(7);
+  GroupingPlan plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
+  ASSERT_EQ(plan.groups.size(), 2u);
+  for (const ImageGroup& g : plan.groups) {
+    EXPECT_GE(g.images.size(), 4u);
+    EXPECT_LE(g.images.size(), 6u);
+  }
+  // A short strip beside full groups: campus's strip 2 (18 images, 6 + 6 +
+  // 6) and the first 3 images of strip 3. No group has room for those 3, so
+  // they are a group, which takes an image of strip 2 that sees its ground.
+  s = MakeSimBlock("campus", false, {2, 3});
+  s.block.images.resize(21);
+  plan = PlanGroups(s.block, StripOptions(), MatcherOptions{});
+  ASSERT_EQ(plan.strips.size(), 2u);
+  ASSERT_EQ(plan.strips[1].size(), 3u);
+  ASSERT_EQ(plan.groups.size(), 4u);
+  for (const ImageGroup& g : plan.groups) EXPECT_GE(g.images.size(), 4u);
+  const std::vector<int>& short_group = plan.groups.back().images;
+  EXPECT_EQ(std::count_if(short_group.begin(), short_group.end(), [](int i) { return i < 18; }), 1);
+  EXPECT_TRUE(plan.ungrouped.empty());
+}
+
 // Ground points (local XY on the mean ground) and the images that see them.
 struct GroundSample {
   Eigen::Vector2d xy;
@@ -651,9 +677,9 @@ TEST(GroupingMemory, BudgetShortensTheRunsOfAStrip) {
   o.memory_budget = EstimateGroupMemory(s.block, {0, 1, 2, 3}, 1).Total() + 1;
   const GroupingPlan plan = PlanGroups(s.block, o, MatcherOptions{});
   // 16 -> 4+4+4+4, 17 -> 4+4+4+3+2, 18 -> 4+4+4+4+2, 16 -> 4+4+4+4, each
-  // run of 2 taking the image before it (min_image_num 3).
-  EXPECT_EQ(Sizes(plan),
-            (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
+  // run of 2 taking the image before it (min_image_num 3), then each group
+  // of 3 an image that sees its ground (the paper's smallest group is 4).
+  EXPECT_EQ(Sizes(plan), std::vector<size_t>(18, 4));
   for (const ImageGroup& g : plan.groups) EXPECT_LE(g.memory.Total(), o.memory_budget);
 }
 
@@ -689,8 +715,7 @@ TEST(GroupingMemory, TheProcessCountsInEveryGroupAndInTheBudget) {
   EXPECT_EQ(with.process_bytes, counted);
   // The same runs as BudgetShortensTheRunsOfAStrip, whose budget is this one
   // less the process.
-  EXPECT_EQ(Sizes(with),
-            (std::vector<size_t>{4, 4, 4, 4, 4, 4, 4, 3, 3, 4, 4, 4, 4, 3, 4, 4, 4, 4}));
+  EXPECT_EQ(Sizes(with), std::vector<size_t>(18, 4));
   for (const ImageGroup& g : with.groups) {
     EXPECT_EQ(g.memory.process_bytes, counted);
     // View-only images are loaded too, but take no points: strip groups'

@@ -113,6 +113,46 @@ std::vector<int> JoinBestGroup(const Block& block, const std::vector<Footprint>&
   return left;
 }
 
+// A strip group under `smallest` images (the second run of a strip of 7 at
+// --max-images 6, a short last strip that no group had room for) takes,
+// as its own images, those of other groups that see most of its images'
+// ground, while it has room and fits. Its centre stays, so the ground it
+// owns is the same; the images only give its patches the views the paper's
+// smallest group (4) has. Climb photos stay views: their GSD is not the
+// strips'.
+void TopUpSmallGroups(const Block& block, const std::vector<Footprint>& fp, size_t smallest,
+                      GroupingPlan* plan) {
+  std::vector<bool> climb(block.images.size(), false);
+  for (const StripOutlier& out : plan->outliers)
+    if (out.kind == OutlierKind::kClimb) climb[out.image] = true;
+  for (ImageGroup& g : plan->groups) {
+    while (g.images.size() < smallest &&
+           static_cast<int>(g.images.size()) < plan->options.max_images) {
+      int best = -1;
+      std::pair<double, double> best_key{0, 0};
+      for (size_t j = 0; j < block.images.size(); ++j) {
+        const int v = static_cast<int>(j);
+        if (climb[j] || std::find(g.images.begin(), g.images.end(), v) != g.images.end()) {
+          continue;
+        }
+        double seen = 0;
+        for (const int i : g.images) seen += OverlapShare(fp, i, v);
+        const std::pair<double, double> key{seen, -(fp[j].center - g.center).squaredNorm()};
+        if (seen <= 0 || (best >= 0 && key <= best_key)) continue;
+        ImageGroup with = g;
+        with.views.erase(std::remove(with.views.begin(), with.views.end(), v), with.views.end());
+        with.images.push_back(v);
+        if (!Fits(block, with, fp, *plan)) continue;
+        best = v;
+        best_key = key;
+      }
+      if (best < 0) break;
+      g.views.erase(std::remove(g.views.begin(), g.views.end(), best), g.views.end());
+      g.images.push_back(best);
+    }
+  }
+}
+
 double SpanDeg(const Block& block, const std::vector<int>& ids, const Eigen::Vector3d& x,
                double view_angle_deg) {
   const double hi = std::cos(view_angle_deg * M_PI / 180.0);

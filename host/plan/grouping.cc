@@ -207,6 +207,7 @@ void PlanStrips(const Block& block, const GroupingOptions& o, const std::vector<
     as_image.push_back(out.kind != OutlierKind::kClimb);
   }
   plan->ungrouped = JoinBestGroup(block, fp, joining, as_image, plan);
+  TopUpSmallGroups(block, fp, smallest, plan);
 }
 
 // Every tile costs kTileSamples^2 point-in-quad tests per image, so a tiny

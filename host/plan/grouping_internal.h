@@ -87,6 +87,10 @@ std::vector<int> JoinBestGroup(const Block& block, const std::vector<Footprint>&
                                const std::vector<int>& images, const std::vector<bool>& as_image,
                                GroupingPlan* plan);
 
+// Strip groups under `smallest` images take, as images, those of other
+// groups that see most of their ground, while they fit.
+void TopUpSmallGroups(const Block& block, const std::vector<Footprint>& fp, size_t smallest,
+                      GroupingPlan* plan);
 // Views from beyond each group until some pair of the images it matches in
 // meets at its images' mean footprint centre at 2 max_angle_deg or more (PatchEngine's
 // WideEnough for the larger adaptive sizes).
