@@ -443,6 +443,50 @@ namespace {
 // ray, a few centimetres here), while without a region the same seeds
 // cover both sides. The region's edge runs through the middle of image 0's
 // ground, in the block's world frame (the group's origin added).
+// In a group larger than a view list, an image that sees a patch's ground
+// though not among its views has its cells there claimed too (within the
+// widest of the patch's views), so that it does not match that ground again
+// as a reference: a strip of 5 where images 0 and 1, both holding seeds of
+// the same ground, match in the far pair (3 and 4) only.
+TEST(Propagator, ImagesBeyondTheViewListDoNotMatchTheSameGroundAgain) {
+  test::PlaneScene scene = test::MakePlaneScene(5, 121, 97, 17, /*strip_base=*/3.0);
+  const std::unique_ptr<PatchKernels> kernels = MakeReferencePatchKernels({"reference"});
+  std::vector<SeedFeature> seeds = SeedsInImage0(scene, 8);
+  for (size_t k = 0, n = seeds.size(); k < n; ++k) {
+    SeedFeature f = seeds[k];
+    f.image = 1;
+    f.uv = scene.cameras[1].Project(f.candidates[0].center);
+    f.candidates[0].ref = 1;
+    seeds.push_back(f);
+  }
+  MatcherOptions options;
+  options.max_angle_deg = 5.0;  // neighbours 3 m apart at 40 m: 4.3 degrees
+  options.max_waves = 4;
+  // Points of references 0 and 1 that land on an image-0 pixel that a point
+  // of the other one landed on: the same ground matched twice.
+  auto twice = [&](bool far_pair_only, long* points) {
+    MatchGroupData group = GroupWithGrey(scene);
+    if (far_pair_only) group.images[0].views = group.images[1].views = {3, 4};
+    PatchEngine engine(*kernels, group, options);
+    Propagator propagator(group, options, engine);
+    propagator.RunSeeds(seeds);
+    propagator.RunWaves({});
+    std::map<std::pair<long, long>, int> by;  // image-0 pixel -> bit per reference
+    for (const DensePoint& d : propagator.points()) {
+      const int ref = propagator.patches()[d.patch].ref;
+      const Eigen::Vector2d uv = scene.cameras[0].Project(d.x);
+      if (ref <= 1) by[{std::lround(uv.x()), std::lround(uv.y())}] |= 1 << ref;
+    }
+    *points = static_cast<long>(propagator.points().size());
+    return std::count_if(by.begin(), by.end(), [](const auto& b) { return b.second == 3; });
+  };
+  long all_points = 0, far_points = 0;
+  const long all_views = twice(false, &all_points);
+  const long far_pair = twice(true, &far_points);
+  ASSERT_GT(far_points, 1000);
+  EXPECT_LE(far_pair, all_views + far_points / 50);
+}
+
 TEST(Propagator, GrowsOnlyOnTheGroundItOwns) {
   test::PlaneScene scene = test::MakePlaneScene(3, 121, 97, 17);
   MatchGroupData group = GroupWithGrey(scene);

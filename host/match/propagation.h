@@ -119,10 +119,15 @@ class Propagator {
   // What a patch would emit: its points (local frame, reference pixel), the
   // reference cell of each, and the cell each lands in in each of the
   // patch's views, view_cells[v * points.size() + k] (-1 outside or behind).
+  // covers: the group's other reference images that see the patch though
+  // not among its views (a group larger than a view list), cover_cells their
+  // cells as view_cells.
   struct EmitPlan {
     std::vector<DensePoint> points;
     std::vector<int> ref_cells;
     std::vector<int> view_cells;
+    std::vector<int> covers;
+    std::vector<int> cover_cells;
   };
   EmitPlan PlanEmit(const AcceptedPatch& patch) const;
   // Emits the planned points of `patch` whose reference cells are still
@@ -148,6 +153,14 @@ class Propagator {
   // wider in the oblique view beside it.
   void OfferInViews(const AcceptedPatch& patch, const DensePoint* first, const DensePoint* last,
                     std::vector<PatchCandidate>* front);
+  // The images whose cells patch p's points claim: its views, then covers_[p].
+  template <typename F>
+  void ForEachClaimImage(int p, F&& f) const {
+    for (const int v : patches_[p].views) f(v);
+    if (!covers_.empty()) {
+      for (const int v : covers_[p]) f(v);
+    }
+  }
   // Patches emit and expand as in pmvs mode.
   bool PmvsStyle() const { return grows_as_pmvs_ || options_.mode == MatchMode::kPmvs; }
   // Frees the cells point d owns, in its reference and its patch's views.
@@ -172,6 +185,11 @@ class Propagator {
   std::vector<EdgeMap> edges_;
   GroundRegion region_;
   std::vector<AcceptedPatch> patches_;
+  // Per reference image, the group's other reference images outside its
+  // view list, which see its ground in a group larger than a view list;
+  // empty lists everywhere otherwise, and then covers_ stays empty.
+  std::vector<std::vector<int>> beyond_views_;
+  std::vector<std::vector<int>> covers_;  // per patch, EmitPlan::covers
   std::vector<DensePoint> points_;
   std::vector<PatchCandidate> front_;
   // cut_[p]: RefitPlanes cut patch p back to its centre (with refill_cut it
