@@ -205,8 +205,9 @@ Propagator::EmitPlan Propagator::PlanEmit(const AcceptedPatch& patch) const {
     }
     // And only within the widest angle its views make with the reference:
     // beyond, the image may see something else there (a roof over a wall's
-    // foot), and claimed there, `city` at --max-images 10 lost 1.0 point of
-    // its truth's coverage, as it did when they scored the patch (NCC).
+    // foot), and claimed there, `city` as one group of 18 images lost 1.0
+    // point of its truth's coverage, as it did when they scored the patch
+    // (NCC).
     if (TriangulationAngleDeg(ref_center, c.center(), patch.center) > widest) continue;
     plan.covers.push_back(i);
     const Grid& g = grids_[i];
