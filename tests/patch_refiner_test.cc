@@ -26,13 +26,13 @@ constexpr double kPiRad = 3.14159265358979323846;
 // scores differ from the double ones by about 1e-5 (ncc_scorer_test), which
 // can flip a near-tie late in the search and end on a neighbouring point of
 // the same optimum, so the tolerance is on the score, not bit-level.
-constexpr double kScoreTol = 2e-3;
+constexpr double kRefineScoreTol = 2e-3;
 // Where every decision of the reference search had a margin above this, the
 // kernel must take the same path; its parameters must then agree to float
 // precision.
-constexpr double kSafeMargin = 1e-4;
-constexpr double kDepthTol = 1e-3;  // Footprints.
-constexpr double kAngleTol = 1e-4;  // Radians.
+constexpr double kRefineSafeMargin = 1e-4;
+constexpr double kRefineDepthTol = 1e-3;  // Footprints.
+constexpr double kRefineAngleTol = 1e-4;  // Radians.
 
 using test::MakePlaneScene;
 using test::PlaneScene;
@@ -76,15 +76,15 @@ RefComparison CompareWithReference(const std::vector<RefinedPatch>& got,
     const RefinedPatchReference& e = expected[i];
     EXPECT_EQ(std::isnan(g.score), std::isnan(e.score)) << "patch " << i;
     if (std::isnan(e.score) || std::isnan(g.score)) continue;
-    EXPECT_NEAR(g.score, e.score, kScoreTol) << "patch " << i;
+    EXPECT_NEAR(g.score, e.score, kRefineScoreTol) << "patch " << i;
     c.worst_score_error = std::max(c.worst_score_error, std::abs(g.score - e.score));
-    if (e.decision_margin > kSafeMargin) {
+    if (e.decision_margin > kRefineSafeMargin) {
       ++c.same_path;
       EXPECT_EQ(g.moves, e.moves) << "patch " << i;
       EXPECT_EQ(g.evaluations, e.evaluations) << "patch " << i;
-      EXPECT_NEAR(g.depth_offset, e.depth_offset, kDepthTol) << "patch " << i;
-      EXPECT_NEAR(g.yaw, e.yaw, kAngleTol) << "patch " << i;
-      EXPECT_NEAR(g.pitch, e.pitch, kAngleTol) << "patch " << i;
+      EXPECT_NEAR(g.depth_offset, e.depth_offset, kRefineDepthTol) << "patch " << i;
+      EXPECT_NEAR(g.yaw, e.yaw, kRefineAngleTol) << "patch " << i;
+      EXPECT_NEAR(g.pitch, e.pitch, kRefineAngleTol) << "patch " << i;
       c.worst_depth_error =
           std::max(c.worst_depth_error, std::abs(g.depth_offset - e.depth_offset));
       c.worst_angle_error =
