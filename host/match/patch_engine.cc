@@ -17,13 +17,18 @@ namespace {
 // float32 rounding of a refined normal's cosine to its reference ray.
 constexpr double kRimSlack = 1e-5;
 
-// True when image `camera` sees the plane (c, n) at most view_angle off its normal.
+}  // namespace
+
 bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,
            double cos_max) {
   return n.dot((camera.center() - c).normalized()) >= cos_max;
 }
 
-}  // namespace
+bool SeesPatch(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,
+               double cos_max, double margin) {
+  return camera.Depth(c) > 0 && camera.InImage(camera.Project(c), margin) &&
+         Faces(camera, c, n, cos_max);
+}
 
 WindowGrid SampledWindow(int side, int window_size, double max_step) {
   const int half = side / 2;
@@ -208,10 +213,7 @@ std::vector<int> PatchEngine::VisibleViews(const Eigen::Vector3d& center,
                                            const Eigen::Vector3d& normal, int ref, int half) const {
   const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
   auto sees = [&](int v) {
-    const Camera& cam = group_.images[v].camera;
-    if (!(cam.Depth(center) > 0)) return false;
-    if (!cam.InImage(cam.Project(center), half + 1)) return false;
-    return normal.dot((cam.center() - center).normalized()) >= cos_max;
+    return SeesPatch(group_.images[v].camera, center, normal, cos_max, half + 1);
   };
   std::vector<int> views, view_only;
   for (const int v : group_.images[ref].views) {

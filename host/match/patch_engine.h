@@ -78,6 +78,16 @@ struct EngineKernels {
 };
 EngineKernels EngineKernelVariants(const MatcherOptions& options);
 
+// True when image `camera` sees the plane (c, n) at most view angle off its
+// normal (cos_max: the cosine of view_angle_deg).
+bool Faces(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,
+           double cos_max);
+// True when c lies in front of `camera`, inside its image by `margin`
+// pixels, and the camera faces the plane (c, n) (Faces): an image a patch
+// there may take as a view.
+bool SeesPatch(const Camera& camera, const Eigen::Vector3d& c, const Eigen::Vector3d& n,
+               double cos_max, double margin);
+
 // The options that evaluate the candidates of sapmvs mode's last passes
 // (MatcherOptions::pmvs_passes) as pmvs mode does: plain NCC at window_size,
 // no polish, within pmvs_pass_view_angle_deg.

@@ -188,21 +188,20 @@ Propagator::EmitPlan Propagator::PlanEmit(const AcceptedPatch& patch) const {
   // as one group of 75 images gave 7.67 M points where its 18 groups of 8
   // kept 2.97 M, in 175 s against 60. Their cells are claimed too, where the
   // patch faces them as a view would (view_angle_deg).
+  const std::vector<int>& beyond = beyond_views_[patch.ref];
+  if (beyond.empty()) return plan;
   const double cos_max = std::cos(options_.view_angle_deg * M_PI / 180.0);
   const Eigen::Vector3d& ref_center = cam.center();
   double widest = 0;
-  if (!beyond_views_[patch.ref].empty()) {
-    for (const int v : patch.views)
-      widest = std::max(widest, TriangulationAngleDeg(ref_center, group_.images[v].camera.center(),
-                                                      patch.center));
+  for (const int v : patch.views) {
+    widest = std::max(
+        widest, TriangulationAngleDeg(ref_center, group_.images[v].camera.center(), patch.center));
   }
-  for (const int i : beyond_views_[patch.ref]) {
-    if (std::find(patch.views.begin(), patch.views.end(), i) != patch.views.end()) continue;
+  // The patch's views come from the reference's list and the group's
+  // view-only images, so none of them is in `beyond`.
+  for (const int i : beyond) {
     const Camera& c = group_.images[i].camera;
-    if (!(c.Depth(patch.center) > 0) || !c.InImage(c.Project(patch.center)) ||
-        patch.normal.dot((c.center() - patch.center).normalized()) < cos_max) {
-      continue;
-    }
+    if (!SeesPatch(c, patch.center, patch.normal, cos_max, 0)) continue;
     // And only within the widest angle its views make with the reference:
     // beyond, the image may see something else there (a roof over a wall's
     // foot), and claimed there, `city` as one group of 18 images lost 1.0

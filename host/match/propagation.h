@@ -213,8 +213,9 @@ class Propagator {
 // kNccWeightMinSpread). The score was decided by the pixels like the
 // centre; the others, across a roof edge or a crown's rim, were hardly
 // counted, and writing the plane there fattened roofs over the ground (on
-// `small`, 1.8 % of all points lay over 5 m above the ground). The centre comes first; with
-// sigma_color or min_weight 0 the weights do not restrict.
+// `small`, 1.8 % of all points lay over 5 m above the ground). The centre
+// comes first; with sigma_color or min_weight 0 the weights do not
+// restrict.
 std::vector<std::pair<int, int>> WindowPixels(const cv::Mat& grey, int cx, int cy, int side,
                                               double sigma_color, double min_weight,
                                               const std::function<bool(int, int)>& barrier);
