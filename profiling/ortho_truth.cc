@@ -50,7 +50,9 @@ nlohmann::json ToJson(const OrthoTruth& r, const std::string& ortho) {
           {"ghost_high", side(r.high)},
           {"ghost_low", side(r.low)},
           {"ghost_high_dsm_right", side(r.high_right)},
-          {"ghost_low_dsm_right", side(r.low_right)}};
+          {"ghost_low_dsm_right", side(r.low_right)},
+          {"ghost_high_step_right", side(r.high_step_right)},
+          {"ghost_low_step_right", side(r.low_step_right)}};
 }
 
 }  // namespace
@@ -105,6 +107,11 @@ int main(int argc, char** argv) {
           "%ld ground edge cells\n",
           options.dsm_tolerance_gsd, 100 * r.high_right.Share(), r.high_right.cells,
           100 * r.low_right.Share(), r.low_right.cells);
+      std::printf(
+          "and right across the step too: wrong side %.1f%% of %ld roof, %.1f%% of %ld ground "
+          "edge cells\n",
+          100 * r.high_step_right.Share(), r.high_step_right.cells, 100 * r.low_step_right.Share(),
+          r.low_step_right.cells);
     }
     if (!json_path.empty()) {
       std::ofstream f(json_path);

@@ -228,8 +228,9 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
     dirs[k] = {std::cos(a), std::sin(a)};
   }
   const GeoRaster& g = ortho.grid;
-  // High, wrong, low, wrong; the same where the ortho's DSM is right.
-  std::vector<std::array<long, 8>> rows(g.height, {0, 0, 0, 0, 0, 0, 0, 0});
+  // High, wrong, low, wrong; the same where the ortho's DSM is right; the
+  // same where it is right on both sides.
+  std::vector<std::array<long, 12>> rows(g.height, std::array<long, 12>{});
   ParallelFor(g.height, [&](long row) {
     for (int col = 0; col < g.width; ++col) {
       const size_t i = static_cast<size_t>(row) * g.width + col;
@@ -265,10 +266,15 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
       const int side = sign < 0 ? 0 : 2;  // the other side lower: this is a roof
       ++rows[row][side];
       rows[row][side + 1] += wrong;
-      if (ortho_dsm && std::abs(OrthoDsmHeight(*ortho_dsm, p.x(), p.y()) - h0) <=
-                           o.dsm_tolerance_gsd * out->gsd) {
+      const double tolerance = o.dsm_tolerance_gsd * out->gsd;
+      if (ortho_dsm && std::abs(OrthoDsmHeight(*ortho_dsm, p.x(), p.y()) - h0) <= tolerance) {
         ++rows[row][4 + side];
         rows[row][4 + side + 1] += wrong;
+        if (std::abs(OrthoDsmHeight(*ortho_dsm, q.x(), q.y()) -
+                     OrthoDsmHeight(dsm, q.x(), q.y())) <= tolerance) {
+          ++rows[row][8 + side];
+          rows[row][8 + side + 1] += wrong;
+        }
       }
     }
   });
@@ -277,6 +283,8 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
     out->low.cells += r[2], out->low.wrong += r[3];
     out->high_right.cells += r[4], out->high_right.wrong += r[5];
     out->low_right.cells += r[6], out->low_right.wrong += r[7];
+    out->high_step_right.cells += r[8], out->high_step_right.wrong += r[9];
+    out->low_step_right.cells += r[10], out->low_step_right.wrong += r[11];
   }
 }
 

@@ -123,8 +123,11 @@ struct OrthoTruth {
   int tiles = 0, tiles_used = 0;
   double shift_median = 0, shift_p95 = 0, shift_east = 0, shift_north = 0;
   EdgeSide high, low;  // roofs and crowns; the ground beside them
-  // The same, of the edge cells where the ortho's DSM is right (with one).
+  // The same, of the edge cells where the ortho's DSM is right (with one);
+  // and of those where it is right on the other side too: where the DSM has
+  // the step, so that a wrong colour is the ortho's doing, not the DSM's.
   EdgeSide high_right, low_right;
+  EdgeSide high_step_right, low_step_right;
   double Coverage() const {
     return truth_cells > 0 ? static_cast<double>(covered_cells) / truth_cells : 0;
   }
@@ -136,7 +139,7 @@ struct OrthoTruth {
 // out of range, the CRSs differ or the ortho misses the truth (the caller
 // names the ortho's file).
 // `ortho_dsm`, when given, is the DSM the ortho was made on (a run's
-// dsm.tif), for high_right and low_right.
+// dsm.tif), for high_right, low_right and the step_right pair.
 OrthoTruth CompareOrthoToTruth(const ColorRaster& ortho, const ColorRaster& truth,
                                const GeoRaster& dsm, const OrthoTruthOptions& options = {},
                                const GeoRaster* ortho_dsm = nullptr);

@@ -15,8 +15,8 @@ work=${1:-/tmp/sapmvs_ortho}
 sapmvs=${SAPMVS:-./build/sapmvs}
 ortho_truth=${ORTHO_TRUTH:-./build/profiling/ortho_truth}
 mkdir -p "$work"
-echo "| block | ortho cells | filled | shift median / p95 (GSD) | luminance error median / p95, bias | wrong side: roofs / ground | where the DSM is right: roofs / ground | ortho time / run |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| block | ortho cells | filled | shift median / p95 (GSD) | luminance error median / p95, bias | wrong side: roofs / ground | where the DSM is right: roofs / ground | where it has the step: roofs / ground | ortho time / run |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for preset in small city campus; do
   block="$work/sim_$preset"
   run="$work/run_$preset"
@@ -38,6 +38,7 @@ print(f'| `{preset}` | {o["width"]:,} × {o["height"]:,} of {o["cell"]:.3f} m '
       f'{t["luminance_median"]:.1f} / {t["luminance_p95"]:.1f}, {t["luminance_bias"]:+.1f} | '
       f'{share(t["ghost_high"])} / {share(t["ghost_low"])} | '
       f'{share(t["ghost_high_dsm_right"])} / {share(t["ghost_low_dsm_right"])} | '
+      f'{share(t["ghost_high_step_right"])} / {share(t["ghost_low_step_right"])} | '
       f'{stages["run ortho"]:.1f} / {r["total_seconds"]:.1f} s |')
 PY
 done

@@ -144,12 +144,23 @@ TEST(OrthoDepthBufferTest, TheBoxHidesTheGroundBehindIt) {
   const GeoRaster dsm = BoxDsm();
   // Low and west of the box: its west wall hides the ground just east of it.
   const Camera camera = NadirCamera({0, 30, 20});
-  const OrthoDepthBuffer depth(camera, dsm, {0, 0, 60, 60}, 1.5);
+  const OrthoDepthBuffer depth(camera, dsm, {0, 0, 60, 60}, 1.0, 0.5);
   Eigen::Vector2d uv;
-  EXPECT_TRUE(depth.Sees({15, 30, 0}, &uv));        // before the box
-  EXPECT_TRUE(depth.Sees({30, 30, kBoxTop}, &uv));  // its roof
-  EXPECT_FALSE(depth.Sees({38, 30, 0}, &uv));       // behind it
-  EXPECT_TRUE(depth.Sees({58, 50, 0}, &uv));        // beside its shadow
+  EXPECT_TRUE(depth.Sees({15, 30, 0}, &uv));          // before the box
+  EXPECT_TRUE(depth.Sees({30, 30, kBoxTop}, &uv));    // its roof
+  EXPECT_TRUE(depth.Sees({24.5, 30, 0}, &uv));        // the ground cell at the wall, in front
+  EXPECT_TRUE(depth.Sees({25.5, 30, kBoxTop}, &uv));  // the roof's edge cell
+  EXPECT_FALSE(depth.Sees({38, 30, 0}, &uv));         // behind it
+  // From above the box's east half, the ray from the ground at 21.3 m
+  // meets the west wall 0.5 m under the roof: drawn as a slope from the
+  // ground's cell centre up to the roof's, the wall would lack the roof's
+  // last half cell, and the ray would pass over it. (The camera puts the
+  // point on a pixel's centre, where the depth is drawn.)
+  const Camera above = NadirCamera({36.9, 30.4, 40});
+  const OrthoDepthBuffer over(above, dsm, {0, 0, 60, 60}, 1.0, 0.5);
+  EXPECT_FALSE(over.Sees({21.3, 30, 0}, &uv));
+  EXPECT_TRUE(over.Sees({25.5, 30, kBoxTop}, &uv));
+  EXPECT_TRUE(depth.Sees({58, 50, 0}, &uv));  // beside its shadow
   EXPECT_NEAR(uv.x(), camera.Project({58, 50, 0}).x(), 1e-9);
 }
 
@@ -166,11 +177,12 @@ TEST_F(TrueOrthoTest, TakesEachCellFromAViewThatSeesIt) {
   EXPECT_EQ(ortho.grid.width, 120);
   EXPECT_EQ(ortho.objects, 1);
   EXPECT_EQ(ortho.images_used, 2);
-  // The ground in A's shadow: its texture, from B; not the wall A sees there.
-  // (Nearer 21 m the DSM, whose cells slope from the ground to the roof
-  // across one cell, lets A see over the wall.)
+  // The ground in A's shadow, from where A sees the roof's edge: its
+  // texture, from B; not the wall A sees there. (Nearer the wall than
+  // 24.5 m, B's pixels of 0.8 m on the ground hold the wall behind the
+  // ground too.)
   int checked = 0;
-  for (double x = 22.25; x < 24.5; x += 0.5) {
+  for (double x = 21.25; x < 24.5; x += 0.5) {
     for (double y = 28.25; y < 32; y += 0.5) {
       bool filled = false;
       const Eigen::Vector3d c = OrthoColour(ortho, x, y, &filled);
@@ -180,7 +192,7 @@ TEST_F(TrueOrthoTest, TakesEachCellFromAViewThatSeesIt) {
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 40);
+  EXPECT_EQ(checked, 56);
   // The roof on its footprint, away from its edges.
   for (double x = 26.25; x < 34; x += 1) {
     bool filled = false;

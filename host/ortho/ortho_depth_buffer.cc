@@ -1,13 +1,14 @@
 #include "ortho/ortho_depth_buffer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
 namespace sapmvs {
 
 OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
-                                   const CellWindow& window, double tolerance)
+                                   const CellWindow& window, double step, double tolerance)
     : camera_(camera),
       width_(camera.width()),
       height_(camera.height()),
@@ -18,16 +19,61 @@ OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
   const int n = window.col1 - window.col0 + 1;
   std::vector<Eigen::Vector3d> above(n), below(n);
   const Eigen::Matrix3d k = camera.intrinsics().K();
+  auto project = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d cam = camera.ToCamera(x);
+    if (!(cam.z() > 0)) return Eigen::Vector3d(0, 0, -1);
+    const Eigen::Vector3d uvw = k * cam;
+    return Eigen::Vector3d(uvw.x() / uvw.z(), uvw.y() / uvw.z(), cam.z());
+  };
   auto project_row = [&](int r, std::vector<Eigen::Vector3d>* out) {
     for (int i = 0; i < n; ++i) {
       const int c = window.col0 + i;
       (*out)[i] = Eigen::Vector3d(0, 0, -1);
       if (c >= dsm.width || r >= dsm.height || dsm.IsEmpty(c, r)) continue;
       const Eigen::Vector2d xy = dsm.CellCenter(c, r);
-      const Eigen::Vector3d cam = camera.ToCamera({xy.x(), xy.y(), dsm.at(c, r)});
-      if (!(cam.z() > 0)) continue;
-      const Eigen::Vector3d uvw = k * cam;
-      (*out)[i] = Eigen::Vector3d(uvw.x() / uvw.z(), uvw.y() / uvw.z(), cam.z());
+      (*out)[i] = project({xy.x(), xy.y(), dsm.at(c, r)});
+    }
+  };
+  auto draw = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    if (a.z() > 0 && b.z() > 0 && c.z() > 0) DrawTriangle(a, b, c);
+  };
+  // A quad across a step, as blocks: each cell's quarter flat at its height,
+  // and walls where the quarters meet. Sloped from the ground's centre to
+  // the roof's, a wall would lack the roof's last half cell, and a ray
+  // passing the wall within that height of the roof would see the ground
+  // behind it: the shadow of every wall a half cell short. Corner j is cell
+  // (c0 + j % 2, r0 + j / 2), `centre` its projected centre.
+  auto draw_blocks = [&](int c0, int r0, const std::array<Eigen::Vector3d, 4>& centre) {
+    const double h = dsm.cell_size / 2;
+    const Eigen::Vector2d first = dsm.CellCenter(c0, r0);
+    const double mx = first.x() + h, my = first.y() - h, x1 = first.x() + 2 * h,
+                 y1 = first.y() - 2 * h;
+    // Per corner, projected at its height: the quad's middle, and the
+    // middles of the quad's sides on its column's line (x = mx) and on its
+    // row's line (y = my).
+    std::array<Eigen::Vector3d, 4> middle, on_x, on_y;
+    std::array<float, 4> z;
+    for (int j = 0; j < 4; ++j) {
+      const int c = c0 + j % 2, r = r0 + j / 2;
+      z[j] = dsm.IsEmpty(c, r) ? std::numeric_limits<float>::quiet_NaN() : dsm.at(c, r);
+      if (std::isnan(z[j])) continue;
+      const double x = j % 2 ? x1 : first.x(), y = j / 2 ? y1 : first.y();
+      middle[j] = project({mx, my, z[j]});
+      on_x[j] = project({mx, y, z[j]});
+      on_y[j] = project({x, my, z[j]});
+      draw(centre[j], on_x[j], middle[j]);
+      draw(centre[j], middle[j], on_y[j]);
+    }
+    // Corners side by side in a row meet on x = mx, in a column on y = my.
+    for (const auto& [i, j] : {std::pair{0, 1}, {2, 3}}) {
+      if (std::isnan(z[i]) || std::isnan(z[j]) || z[i] == z[j]) continue;
+      draw(middle[i], on_x[i], on_x[j]);
+      draw(middle[i], on_x[j], middle[j]);
+    }
+    for (const auto& [i, j] : {std::pair{0, 2}, {1, 3}}) {
+      if (std::isnan(z[i]) || std::isnan(z[j]) || z[i] == z[j]) continue;
+      draw(middle[i], on_y[i], on_y[j]);
+      draw(middle[i], on_y[j], middle[j]);
     }
   };
   const int row1 = std::min(window.row1 + 1, dsm.height);
@@ -36,6 +82,11 @@ OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
   for (int r = window.row0 + 1; r < row1; ++r) {
     project_row(r, &below);
     for (int i = 0; i + 1 < n; ++i) {
+      const int col = window.col0 + i;
+      if (col + 1 < dsm.width && QuadSpan(dsm, col, r - 1) > step) {
+        draw_blocks(col, r - 1, {above[i], above[i + 1], below[i], below[i + 1]});
+        continue;
+      }
       const Eigen::Vector3d &a = above[i], &b = above[i + 1], &c = below[i], &d = below[i + 1];
       if (a.z() > 0 && b.z() > 0 && c.z() > 0) DrawTriangle(a, b, c);
       if (b.z() > 0 && d.z() > 0 && c.z() > 0) DrawTriangle(b, d, c);

@@ -3,7 +3,8 @@
 // surface (a z-buffer), so that a ground point hidden behind a roof or a
 // tree in that image is known to be hidden. The DSM is drawn as two
 // triangles between the centres of every 2 x 2 valid cells, a surface
-// without holes between the cells.
+// without holes between the cells; where those four heights span a step,
+// as blocks: each cell flat to its sides, walls between.
 #include <Eigen/Core>
 #include <vector>
 
@@ -16,12 +17,12 @@ namespace sapmvs {
 class OrthoDepthBuffer {
  public:
   // Draws the cells of `dsm` in `window` as `camera` (a pinhole camera, the
-  // image's at the level) sees them. A point counts as seen when it lies at
-  // most `tolerance` (CRS units) behind the drawn surface: the ortho's
-  // heights interpolate the same cells, and a point on the surface must
-  // not hide itself.
+  // image's at the level) sees them, as blocks where four heights span more
+  // than `step` (OrthoSurface::step). A point counts as seen when it lies at
+  // most `tolerance` (CRS units) behind the drawn surface: a point on the
+  // surface, tested at the nearest pixel, must not hide itself.
   OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm, const CellWindow& window,
-                   double tolerance);
+                   double step, double tolerance);
 
   // Whether world point `x` is in the image and not hidden; its pixel in
   // `uv` then.

@@ -1,6 +1,7 @@
 #include "ortho/ortho_surface.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -14,12 +15,23 @@ namespace sapmvs {
 namespace {
 
 constexpr double kMaxOrthoCells = 268435456.0;  // 2^28, as the DSM
+// Heights that differ by more than this many cells from one cell to the
+// next (63 degrees) are a wall: drawn as one and not interpolated across.
+// Steeper than the objects' slope: a canopy's and rough ground's cells
+// differ by one or two, and drawing each of those as a wall made a
+// forested flight's ortho half as slow again, for colours no better on
+// the simulated blocks.
+constexpr double kWallSlope = 2.0;
 
-// Bilinear between the centres of the valid cells among the four around
-// (x, y), where they lie on one surface; across a step higher than `step`
-// (a roof's edge, a wall), the nearest cell's height: interpolated, a roof
-// would lean half a cell over the ground at its foot and be drawn there
-// again. NaN when none of the four is valid.
+// On the surface the depth buffers draw (OrthoDepthBuffer): where the four
+// cell centres around (x, y) are valid and lie on one surface, the plane of
+// the triangle it falls in, so that a point of the ortho lies on the drawn
+// surface and no tolerance for its own surface hides an occluder; across a
+// step higher than `step` (a roof's edge, a wall), the nearest cell's
+// height, as the blocks drawn there; interpolated, a roof would lean half a
+// cell over the ground at its foot and be drawn there again. Where some of
+// the four are empty, bilinear from those that are not. NaN when none is
+// valid.
 float InterpolateHeight(const GeoRaster& dsm, double x, double y, double step) {
   const double fc = (x - dsm.origin_x) / dsm.cell_size - 0.5;
   const double fr = (dsm.origin_y - y) / dsm.cell_size - 0.5;
@@ -27,25 +39,33 @@ float InterpolateHeight(const GeoRaster& dsm, double x, double y, double step) {
   const double tx = fc - c0, ty = fr - r0;
   double sum = 0, weight = 0, nearest_w = -1;
   float lo = std::numeric_limits<float>::infinity(), hi = -lo, nearest = 0;
+  std::array<float, 4> z;
+  int valid = 0;
   for (int dr = 0; dr < 2; ++dr) {
     for (int dc = 0; dc < 2; ++dc) {
       const int c = std::clamp(c0 + dc, 0, dsm.width - 1);
       const int r = std::clamp(r0 + dr, 0, dsm.height - 1);
+      z[2 * dr + dc] = dsm.at(c, r);
       if (dsm.IsEmpty(c, r)) continue;
-      const float z = dsm.at(c, r);
+      ++valid;
       const double w = (dc ? tx : 1 - tx) * (dr ? ty : 1 - ty) + 1e-9;
-      sum += w * z;
+      sum += w * z[2 * dr + dc];
       weight += w;
-      lo = std::min(lo, z);
-      hi = std::max(hi, z);
+      lo = std::min(lo, z[2 * dr + dc]);
+      hi = std::max(hi, z[2 * dr + dc]);
       if (w > nearest_w) {
         nearest_w = w;
-        nearest = z;
+        nearest = z[2 * dr + dc];
       }
     }
   }
   if (!(weight > 0)) return std::numeric_limits<float>::quiet_NaN();
-  return hi - lo > step ? nearest : static_cast<float>(sum / weight);
+  if (hi - lo > step) return nearest;
+  if (valid < 4) return static_cast<float>(sum / weight);
+  // The triangles split the quad along the diagonal from (c0 + 1, r0) to
+  // (c0, r0 + 1).
+  if (tx + ty <= 1) return static_cast<float>(z[0] + tx * (z[1] - z[0]) + ty * (z[2] - z[0]));
+  return static_cast<float>(z[3] + (1 - tx) * (z[2] - z[3]) + (1 - ty) * (z[1] - z[3]));
 }
 
 void FindObjects(const GeoRaster& dsm, double object_slope, double margin, OrthoSurface* s) {
@@ -90,6 +110,19 @@ void FindObjects(const GeoRaster& dsm, double object_slope, double margin, Ortho
 }
 
 }  // namespace
+
+double QuadSpan(const GeoRaster& dsm, int col, int row) {
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (int dr = 0; dr < 2; ++dr) {
+    for (int dc = 0; dc < 2; ++dc) {
+      const int c = col + dc, r = row + dr;
+      if (c >= dsm.width || r >= dsm.height || dsm.IsEmpty(c, r)) continue;
+      lo = std::min(lo, dsm.at(c, r));
+      hi = std::max(hi, dsm.at(c, r));
+    }
+  }
+  return hi > lo ? hi - lo : 0.0;
+}
 
 long FillEnclosedHoles(GeoRaster* dsm) {
   const int w = dsm->width, h = dsm->height;
@@ -155,6 +188,7 @@ OrthoSurface MakeOrthoSurface(const GeoRaster& source, double cell, double objec
   g.values.resize(static_cast<size_t>(g.width) * g.height);
   s.dsm_col.resize(g.width);
   s.dsm_row.resize(g.height);
+  s.step = kWallSlope * dsm.cell_size;
   for (int c = 0; c < g.width; ++c) {
     s.dsm_col[c] = std::min(dsm.width - 1, static_cast<int>((c + 0.5) * cell / dsm.cell_size));
   }
@@ -164,8 +198,7 @@ OrthoSurface MakeOrthoSurface(const GeoRaster& source, double cell, double objec
   ParallelFor(g.height, [&](long r) {
     for (int c = 0; c < g.width; ++c) {
       const Eigen::Vector2d p = g.CellCenter(c, static_cast<int>(r));
-      g.at(c, static_cast<int>(r)) =
-          InterpolateHeight(dsm, p.x(), p.y(), object_slope * dsm.cell_size);
+      g.at(c, static_cast<int>(r)) = InterpolateHeight(dsm, p.x(), p.y(), s.step);
     }
   });
   s.zmin = std::numeric_limits<double>::infinity();

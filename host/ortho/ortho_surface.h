@@ -27,11 +27,18 @@ struct OrthoSurface {
   // The DSM cell under each ortho column and row.
   std::vector<int> dsm_col, dsm_row;
   double zmin = 0, zmax = 0;  // the DSM's height range
+  // Heights that differ by more than this from one cell to the next are a
+  // wall, CRS units.
+  double step = 0;
 
   int ObjectAt(int col, int row) const {
     return dsm_object[static_cast<size_t>(dsm_row[row]) * dsm.width + dsm_col[col]];
   }
 };
+
+// The range of the heights of the valid cells among (col, row) and its
+// neighbours east, south and south-east: 0 for fewer than two.
+double QuadSpan(const GeoRaster& dsm, int col, int row);
 
 // Fills each hole of `dsm` that the valid cells enclose with a low height
 // of its rim (the 10th percentile): such holes are mostly ground that few

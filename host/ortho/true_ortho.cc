@@ -23,10 +23,11 @@ namespace {
 // Objects and the ground this many cells around them go with their image,
 // beyond the blend, so that the blend stays on open ground.
 constexpr int kObjectMarginCells = 2;
-// A point lies on the drawn DSM surface within this many DSM cells: the
-// ortho's heights interpolate the cells differently from the triangles, and
-// at a roof's edge the triangles slope down to the ground.
-constexpr double kSeenToleranceCells = 1.5;
+// A point on the drawn DSM surface lies behind the depth at its nearest
+// pixel by at most this many DSM cells (the surface's slope over half a
+// pixel); a cell's centre at a wall's foot lies half a cell from the wall,
+// and at least as far behind it in a view that looks over the wall at it.
+constexpr double kSeenToleranceCells = 0.5;
 // Gaps no image sees are inpainted up to this many cells from a colour.
 constexpr int kGapCells = 4;
 // Images decoded, and depth buffers held, at once, at most.
@@ -188,7 +189,7 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
       static_cast<long>(views.size()),
       [&](long k) {
         const OrthoView& v = views[k];
-        const OrthoDepthBuffer depth(v.camera, dsm, v.dsm_cells, tolerance);
+        const OrthoDepthBuffer depth(v.camera, dsm, v.dsm_cells, surface.step, tolerance);
         for (int r = v.dsm_cells.row0; r < v.dsm_cells.row1; ++r) {
           for (int c = v.dsm_cells.col0; c < v.dsm_cells.col1; ++c) {
             if (dsm.IsEmpty(c, r)) continue;
@@ -255,7 +256,8 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
           const OrthoView& v = views[used_views[first + j]];
           const LoadedImage image = LoadUndistorted(block.images[v.image]);
           loaded[j] = ResampleToLevel(image.pixels, level, v.camera.width(), v.camera.height());
-          depths[j] = std::make_unique<OrthoDepthBuffer>(v.camera, dsm, v.dsm_cells, tolerance);
+          depths[j] = std::make_unique<OrthoDepthBuffer>(v.camera, dsm, v.dsm_cells, surface.step,
+                                                         tolerance);
         },
         1);
     for (size_t j = 0; j < n; ++j) {
