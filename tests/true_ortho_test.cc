@@ -117,6 +117,23 @@ TEST(OrthoSurfaceTest, FillsTheHolesTheSurfaceEncloses) {
   EXPECT_TRUE(dsm.IsEmpty(1, 8));
 }
 
+TEST(OrthoSurfaceTest, AHoleKeepsItsRimsHeightsNextToTheRim) {
+  // Ground at 0 west of column 3, a roof at 10 east of column 8, and
+  // between them five empty columns: a roof's edge and the ground at its
+  // foot that matched nothing.
+  GeoRaster dsm = FlatDsm(12, 1.0, 0);
+  for (int r = 0; r < 12; ++r) {
+    for (int c = 8; c < 12; ++c) dsm.at(c, r) = 10;
+  }
+  for (int r = 2; r < 10; ++r) {
+    for (int c = 3; c < 8; ++c) dsm.at(c, r) = std::nanf("");
+  }
+  EXPECT_EQ(FillEnclosedHoles(&dsm), 40);
+  EXPECT_EQ(dsm.at(3, 5), 0.f);   // beside the ground
+  EXPECT_EQ(dsm.at(7, 5), 10.f);  // beside the roof
+  EXPECT_EQ(dsm.at(6, 5), 0.f);   // two cells from the roof: the rim's low height
+}
+
 TEST(OrthoSurfaceTest, ABoxIsOneObjectAndFlatGroundNone) {
   const OrthoSurface flat = MakeOrthoSurface(FlatDsm(60, 1.0, 3), 0.5, 1.0, 1.0);
   EXPECT_EQ(flat.objects, 0);

@@ -22,6 +22,12 @@ constexpr double kMaxOrthoCells = 268435456.0;  // 2^28, as the DSM
 // forested flight's ortho half as slow again, for colours no better on
 // the simulated blocks.
 constexpr double kWallSlope = 2.0;
+// A hole's cells this near its rim take the nearest rim cell's height; the
+// rest a low height of the rim. The points a roof's edge lacks (patches
+// straddling it match neither side) leave a cell or two of hole between
+// roof and ground: filled low, the roof shrank, and the images that lean
+// it over the ground beside it coloured that ground with it.
+constexpr float kRimCells = 1.5f;
 
 // On the surface the depth buffers draw (OrthoDepthBuffer): where the four
 // cell centres around (x, y) are valid and lie on one surface, the plane of
@@ -153,12 +159,32 @@ long FillEnclosedHoles(GeoRaster* dsm) {
     std::nth_element(rim[i].begin(), at, rim[i].end());
     fill[i] = *at;
   }
+  // The nearest valid cell of each empty one (its label's), for the cells
+  // at a hole's rim.
+  cv::Mat invalid(h + 2, w + 2, CV_8U, cv::Scalar(255)), distance, nearest;
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      if (!dsm->IsEmpty(c, r)) invalid.at<uint8_t>(r + 1, c + 1) = 0;
+    }
+  }
+  cv::distanceTransform(invalid, distance, nearest, cv::DIST_L2, cv::DIST_MASK_5,
+                        cv::DIST_LABEL_PIXEL);
+  std::vector<float> height_of(static_cast<size_t>(h) * w + 1,
+                               std::numeric_limits<float>::quiet_NaN());
+  for (int r = 1; r <= h; ++r) {
+    for (int c = 1; c <= w; ++c) {
+      if (!dsm->IsEmpty(c - 1, r - 1)) height_of[nearest.at<int>(r, c)] = dsm->at(c - 1, r - 1);
+    }
+  }
   long filled = 0;
   for (int r = 1; r <= h; ++r) {
     for (int c = 1; c <= w; ++c) {
       const int hole = labels.at<int>(r, c);
       if (hole == 0 || std::isnan(fill[hole])) continue;
-      dsm->at(c - 1, r - 1) = fill[hole];
+      const float rim_height = height_of[nearest.at<int>(r, c)];
+      dsm->at(c - 1, r - 1) = distance.at<float>(r, c) <= kRimCells && !std::isnan(rim_height)
+                                  ? rim_height
+                                  : fill[hole];
       ++filled;
     }
   }

@@ -44,7 +44,9 @@ double QuadSpan(const GeoRaster& dsm, int col, int row);
 // of its rim (the 10th percentile): such holes are mostly ground that few
 // images see, beside walls and under trees, or water, which matches no
 // texture; the ortho still needs a surface there to take colours from, and
-// visibility then picks the images that see it. Returns the cells filled.
+// visibility then picks the images that see it. The hole's cells within 1.5
+// cells of its rim take the nearest rim cell's height instead: a roof's
+// edge that matched no points stays the roof's. Returns the cells filled.
 long FillEnclosedHoles(GeoRaster* dsm);
 
 // `dsm` with its enclosed holes filled (FillEnclosedHoles), then heights
