@@ -67,6 +67,42 @@ TEST(NearestWithin, FindsWhatAScanOfEveryPairFinds) {
   }
 }
 
+// In the grid's order: every point has a row, and a row holds its point's
+// neighbours of the scan, in the scan's order, as rows.
+TEST(NearestWithin, RowsInTheGridsOrderHoldTheScansNeighbours) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0, 1);
+  const int n = 1201, k = 16;
+  std::vector<float> xyz;
+  std::vector<double> radius;
+  for (int i = 0; i < n; ++i) {
+    const float x = u(rng) * 25, y = u(rng) * 25;
+    xyz.insert(xyz.end(), {x - 300.f, y + 40.f, 0.3f * std::cos(y) + 0.05f * u(rng)});
+    radius.push_back(0.5 + 2.0 * u(rng));
+  }
+  std::vector<int32_t> order;
+  const auto got = NearestWithin(xyz, radius, k, &order);
+  const std::vector<int32_t> want = ScanAll(xyz, radius, k);
+  ASSERT_EQ(order.size(), static_cast<size_t>(n));
+  std::vector<int32_t> row_of(n, -1);
+  for (int r = 0; r < n; ++r) {
+    ASSERT_GE(order[r], 0);
+    ASSERT_LT(order[r], n);
+    ASSERT_EQ(row_of[order[r]], -1) << "point " << order[r] << " has two rows";
+    row_of[order[r]] = r;
+  }
+  long differ = 0, rows_moved = 0;
+  for (int r = 0; r < n; ++r) {
+    rows_moved += order[r] != r;
+    for (int j = 0; j < k; ++j) {
+      const int32_t b = want[static_cast<size_t>(order[r]) * k + j];
+      differ += got[static_cast<size_t>(r) * k + j] != (b < 0 ? -1 : row_of[b]);
+    }
+  }
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(rows_moved, n / 2);  // the grid's order is not the input's
+}
+
 // Equal distances (a lattice, and points repeated at one place) are ordered
 // by index; a radius exactly at a lattice distance keeps that neighbour; a
 // radius of 0 keeps only repeats.

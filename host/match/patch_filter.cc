@@ -244,10 +244,10 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   stats->removed_visibility = static_cast<long>(points.size() - alive.size()) - low;
   if (alive.empty()) return keep;
 
-  // nn[a * k + j]: the j-th nearest neighbour of point a within a's radius,
-  // neighbour_radius footprints along its plane's slope, so that a surface
-  // seen obliquely, whose points lie further apart, keeps as many neighbours
-  // as one seen face-on; or -1.
+  // nn[a * k + j]: the row of the j-th nearest neighbour of row a's point
+  // (alive[a]) within a's radius, neighbour_radius footprints along its
+  // plane's slope, so that a surface seen obliquely, whose points lie
+  // further apart, keeps as many neighbours as one seen face-on; or -1.
   const int k = kNeighbours;
   UninitializedVector<int32_t> nn;
   {
@@ -261,17 +261,32 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
       for (int c = 0; c < 3; ++c) xyz[3 * a + c] = static_cast<float>(p.x[c]);
       radius[a] = options.neighbour_radius * SlopeFootprint(camera, p.x, patch.normal);
     }
-    nn = NearestWithin(std::move(xyz), radius, k);
+    // Rows in the grid's order: each point's neighbours are then rows near
+    // its own, and the reads through them below stay in cache (in the
+    // points' order they were a cache miss each).
+    std::vector<int32_t> order;
+    nn = NearestWithin(std::move(xyz), radius, k, &order);
+    std::vector<int> by_row(alive.size());
+    for (size_t r = 0; r < alive.size(); ++r) by_row[r] = alive[order[r]];
+    alive.swap(by_row);
   }
+  // What the tests below read of each row's point and its neighbours', in
+  // the rows' order.
+  struct RowPoint {
+    Eigen::Vector3d x;
+    int patch;
+  };
+  UninitializedVector<RowPoint> row(alive.size());
+#pragma omp parallel for schedule(static)
+  for (size_t a = 0; a < alive.size(); ++a) row[a] = {points[alive[a]].x, points[alive[a]].patch};
   // Each point's footprint in its reference image, the unit of the plane
-  // distances below. Only once the search is done: beside its grid and
-  // table, the search's peak is the filter's (8 bytes a point, 9 MiB on
-  // Herz-Jesu-P8).
+  // distances below. Only once the search is done, as `row`: beside its
+  // grid and table, they would raise the filter's peak, which is the
+  // search's (40 bytes a point, 45 MiB on Herz-Jesu-P8).
   UninitializedVector<double> footprint(alive.size());
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
-    const DensePoint& p = points[alive[a]];
-    footprint[a] = Footprint(group.images[patches[p.patch].ref].camera, p.x);
+    footprint[a] = Footprint(group.images[patches[row[a].patch].ref].camera, row[a].x);
   }
 
   // The distance, in footprints, from the plane of point a's patch to its
@@ -281,8 +296,8 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   auto foreign_distance = [&](size_t a, int j) {
     const int32_t b = nn[a * k + j];
     if (b < 0) return std::nanf("");
-    const DensePoint& p = points[alive[a]];
-    const DensePoint& q = points[alive[b]];
+    const RowPoint& p = row[a];
+    const RowPoint& q = row[b];
     if (q.patch == p.patch) return std::nanf("");
     const AcceptedPatch& patch = patches[p.patch];
     return static_cast<float>(std::abs(patch.normal.dot(q.x - patch.center)) / footprint[a]);
@@ -305,7 +320,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   std::vector<uint8_t> pass(alive.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
-    const DensePoint& p = points[alive[a]];
+    const RowPoint& p = row[a];
     const double fp = footprint[a];
     // The neighbours in nn's order, without a per-point allocation.
     int count = 0;
@@ -313,7 +328,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     for (int j = 0; j < k; ++j) {
       const int32_t b = nn[a * k + j];
       if (b < 0) continue;
-      mean += points[alive[b]].x;
+      mean += row[b].x;
       ++count;
     }
     if (count < options.min_neighbours) continue;
@@ -322,7 +337,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     for (int j = 0; j < k; ++j) {
       const int32_t b = nn[a * k + j];
       if (b < 0) continue;
-      const Eigen::Vector3d d = points[alive[b]].x - mean;
+      const Eigen::Vector3d d = row[b].x - mean;
       cov += d * d.transpose();
     }
     // The closed form: Eigen's iterative solver was 2.5 % of Herz-Jesu-P8's
@@ -355,7 +370,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   std::vector<int> foreign(patches.size(), 0), consistent(patches.size(), 0);
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
-    const int id = points[alive[a]].patch;
+    const int id = row[a].patch;
     int f = 0, c = 0;
     for (int j = 0; j < k; ++j) {
       const float d = foreign_distance(a, j);
@@ -375,7 +390,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   };
   long removed_plane = 0;
   for (size_t a = 0; a < alive.size(); ++a) {
-    if (pass[a] && !supported(points[alive[a]].patch)) pass[a] = 0;
+    if (pass[a] && !supported(row[a].patch)) pass[a] = 0;
     if (!pass[a]) {
       keep[alive[a]] = false;
       ++removed_plane;

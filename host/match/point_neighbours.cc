@@ -213,7 +213,8 @@ class ColumnGrid {
 }  // namespace
 
 UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
-                                           const std::vector<double>& radius, int k) {
+                                           const std::vector<double>& radius, int k,
+                                           std::vector<int32_t>* order) {
   const size_t n = radius.size();
   if (xyz.size() != 3 * n) {
     throw Error("NearestWithin: expected 3 coordinates per radius (" + std::to_string(xyz.size()) +
@@ -243,6 +244,16 @@ UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
   // times their size at k = 16, is only allocated once the input is gone:
   // this is the peak of the filter, which is the peak of a group's run.
   std::vector<float>().swap(xyz);  // `xyz = {}` would keep the capacity
+  // Each point's row: its own index, or its place in the grid's order.
+  std::vector<int32_t> row;
+  if (order) {
+    order->resize(n);
+    row.resize(n);
+    for (size_t e = 0; e < n; ++e) {
+      (*order)[e] = grid.entry(e).index;
+      row[grid.entry(e).index] = static_cast<int32_t>(e);
+    }
+  }
   // Each row is written whole by the thread that searches its point, which
   // so takes its pages' first faults.
   UninitializedVector<int32_t> out(n * static_cast<size_t>(k));
@@ -259,8 +270,12 @@ UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
       // radius is never in a cell beyond the box.
       const double reach =
           radius[a] * (1 + 1e-5) + 1e-6 * (std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2]) + 1);
+      int32_t* mine = &out[(order ? e : a) * k];
       grid.Nearest(q, static_cast<int32_t>(a), static_cast<float>(radius[a] * radius[a]), reach, k,
-                   &out[a * k], &best);
+                   mine, &best);
+      if (order) {
+        for (int j = 0; j < k && mine[j] >= 0; ++j) mine[j] = row[mine[j]];
+      }
     }
   }
   return out;

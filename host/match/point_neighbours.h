@@ -23,10 +23,17 @@ namespace sapmvs {
 // z order, is at most float(radius[a]^2), nearest first (ties by index);
 // row a is out[a * k .. a * k + k), padded with -1 (every slot is
 // written). Throws Error when the sizes disagree, k < 1, a radius is
-// negative or not finite, or there are more than 2^31 - 1 points. `xyz` is taken by value so that a
-// caller that moves it in frees it before the output is allocated.
+// negative or not finite, or there are more than 2^31 - 1 points. `xyz` is
+// taken by value so that a caller that moves it in frees it before the
+// output is allocated.
+//
+// With `order`, the points are numbered in the grid's order instead: row r
+// is point (*order)[r]'s, and its neighbours are given by their rows. Points
+// near each other then have rows near each other, so that a caller reading
+// its own per-point data through the rows finds the neighbours' in cache.
 UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
-                                           const std::vector<double>& radius, int k);
+                                           const std::vector<double>& radius, int k,
+                                           std::vector<int32_t>* order = nullptr);
 
 // For each of `queries` (indices of points of `xyz`, laid out as above): the
 // index of its nearest other point at any distance, by the float distance
