@@ -1,6 +1,7 @@
 #include "match/patch_filter.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -279,28 +280,27 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   UninitializedVector<RowPoint> row(alive.size());
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) row[a] = {points[alive[a]].x, points[alive[a]].patch};
-  // Each point's footprint in its reference image, the unit of the plane
-  // distances below. Only once the search is done, as `row`: beside its
-  // grid and table, they would raise the filter's peak, which is the
-  // search's (40 bytes a point, 45 MiB on Herz-Jesu-P8).
-  UninitializedVector<double> footprint(alive.size());
-#pragma omp parallel for schedule(static)
-  for (size_t a = 0; a < alive.size(); ++a) {
-    footprint[a] = Footprint(group.images[patches[row[a].patch].ref].camera, row[a].x);
-  }
-
-  // The distance, in footprints, from the plane of point a's patch to its
-  // j-th neighbour when that neighbour belongs to another patch, else NaN:
-  // the plane tolerance and test 2b below both come from these. Computed
-  // where needed rather than stored: kept, they were as large as `nn`.
-  auto foreign_distance = [&](size_t a, int j) {
-    const int32_t b = nn[a * k + j];
-    if (b < 0) return std::nanf("");
+  // Row a's point's footprint in its reference image, the unit of the plane
+  // distances below: computed once per row where a loop needs it rather
+  // than stored, which beside `nn` and `row` raised the filter's peak.
+  auto footprint = [&](size_t a) {
+    return Footprint(group.images[patches[row[a].patch].ref].camera, row[a].x);
+  };
+  // The distances, in footprints, from the plane of row a's patch to its k
+  // neighbours, each NaN where the neighbour belongs to the same patch or
+  // there is none: the plane tolerance and test 2b below both come from
+  // these. Computed where needed rather than stored: kept, they were as
+  // large as `nn`.
+  auto foreign_distances = [&](size_t a, float* out) {
     const RowPoint& p = row[a];
-    const RowPoint& q = row[b];
-    if (q.patch == p.patch) return std::nanf("");
     const AcceptedPatch& patch = patches[p.patch];
-    return static_cast<float>(std::abs(patch.normal.dot(q.x - patch.center)) / footprint[a]);
+    const double fp = footprint(a);
+    for (int j = 0; j < k; ++j) {
+      const int32_t b = nn[a * k + j];
+      out[j] = std::nanf("");
+      if (b < 0 || row[b].patch == p.patch) continue;
+      out[j] = static_cast<float>(std::abs(patch.normal.dot(row[b].x - patch.center)) / fp);
+    }
   };
   // The plane tolerance: at least plane_tolerance footprints, else
   // plane_sigmas robust standard deviations of those distances (1.4826 x
@@ -309,8 +309,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   // simulator's `small`, 0.43 on NGI's scans); one fixed tolerance either lets
   // roof planes stray over the ground on the one or strips the other.
   double tolerance = options.plane_tolerance;
-  const float median = StreamedMedian(
-      alive.size() * k, [&](size_t i) { return foreign_distance(i / k, static_cast<int>(i % k)); });
+  const float median = StreamedMedianOfRows(alive.size(), k, foreign_distances);
   if (!std::isnan(median)) tolerance = std::max(tolerance, options.plane_sigmas * 1.4826 * median);
   stats->plane_tolerance = tolerance;
 
@@ -321,7 +320,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
 #pragma omp parallel for schedule(static)
   for (size_t a = 0; a < alive.size(); ++a) {
     const RowPoint& p = row[a];
-    const double fp = footprint[a];
+    const double fp = footprint(a);
     // The neighbours in nn's order, without a per-point allocation.
     int count = 0;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -372,8 +371,9 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
   for (size_t a = 0; a < alive.size(); ++a) {
     const int id = row[a].patch;
     int f = 0, c = 0;
-    for (int j = 0; j < k; ++j) {
-      const float d = foreign_distance(a, j);
+    std::array<float, kNeighbours> distances;
+    foreign_distances(a, distances.data());
+    for (const float d : distances) {
       if (std::isnan(d)) continue;
       ++f;
       c += d <= tolerance;
@@ -397,6 +397,8 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     }
   }
   stats->removed_neighbourhood = removed_plane;
+  // The clusters read the table alone: their arrays take row's place.
+  UninitializedVector<RowPoint>().swap(row);
 
   // 3. Small clusters among the survivors.
   const long n_alive = static_cast<long>(alive.size());

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -239,20 +240,14 @@ UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
     std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
     median = sorted[n / 2];
   }
-  const ColumnGrid grid(xyz, 0.5 * median);
+  auto grid = std::make_unique<const ColumnGrid>(xyz, 0.5 * median);
   // The grid's entries hold the coordinates from here on. The output, four
   // times their size at k = 16, is only allocated once the input is gone:
   // this is the peak of the filter, which is the peak of a group's run.
   std::vector<float>().swap(xyz);  // `xyz = {}` would keep the capacity
-  // Each point's row: its own index, or its place in the grid's order.
-  std::vector<int32_t> row;
   if (order) {
     order->resize(n);
-    row.resize(n);
-    for (size_t e = 0; e < n; ++e) {
-      (*order)[e] = grid.entry(e).index;
-      row[grid.entry(e).index] = static_cast<int32_t>(e);
-    }
+    for (size_t e = 0; e < n; ++e) (*order)[e] = grid->entry(e).index;
   }
   // Each row is written whole by the thread that searches its point, which
   // so takes its pages' first faults.
@@ -264,18 +259,26 @@ UninitializedVector<int32_t> NearestWithin(std::vector<float> xyz,
     // In the grid's order, so that consecutive queries read the same columns.
 #pragma omp for schedule(dynamic, 512)
     for (size_t e = 0; e < n; ++e) {
-      const float q[3] = {grid.entry(e).x, grid.entry(e).y, grid.entry(e).z};
-      const size_t a = static_cast<size_t>(grid.entry(e).index);
+      const Entry& entry = grid->entry(e);
+      const float q[3] = {entry.x, entry.y, entry.z};
+      const size_t a = static_cast<size_t>(entry.index);
       // Padded, so that a point whose float distance rounds to within the
       // radius is never in a cell beyond the box.
       const double reach =
           radius[a] * (1 + 1e-5) + 1e-6 * (std::abs(q[0]) + std::abs(q[1]) + std::abs(q[2]) + 1);
-      int32_t* mine = &out[(order ? e : a) * k];
-      grid.Nearest(q, static_cast<int32_t>(a), static_cast<float>(radius[a] * radius[a]), reach, k,
-                   mine, &best);
-      if (order) {
-        for (int j = 0; j < k && mine[j] >= 0; ++j) mine[j] = row[mine[j]];
-      }
+      grid->Nearest(q, static_cast<int32_t>(a), static_cast<float>(radius[a] * radius[a]), reach, k,
+                    &out[(order ? e : a) * k], &best);
+    }
+  }
+  if (order) {
+    // The neighbours as rows, once the grid is gone: its entries are five
+    // times the size of the map.
+    grid.reset();
+    std::vector<int32_t> row(n);
+    for (size_t e = 0; e < n; ++e) row[(*order)[e]] = static_cast<int32_t>(e);
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < out.size(); ++i) {
+      if (out[i] >= 0) out[i] = row[out[i]];
     }
   }
   return out;

@@ -10,16 +10,18 @@
 
 namespace sapmvs {
 
-// Of the m values value(i), i < n, that are not NaN (all others >= 0), the
-// one at index m / 2 once sorted: what nth_element places at begin() + m / 2
-// of them. NaN when m = 0. value(i) must return the same float each time it
-// is called (it is called twice per i, from several threads).
+// Of the m values that `fill` gives, k per row, that are not NaN (all
+// others >= 0): the one at index m / 2 once sorted, what nth_element places
+// at begin() + m / 2 of them. NaN when m = 0. fill(r, out) writes row r's k
+// values to out[0..k); it must write the same floats each time it is called
+// (it is called twice per row, from several threads). A row's values come
+// together, so that what they share is computed once.
 //
 // A histogram of the top 16 bits of each value's float representation,
 // which orders floats >= 0 as their values, finds the bin the median falls
 // in; only that bin's values are then gathered and selected from.
-template <typename Value>
-float StreamedMedian(size_t n, const Value& value) {
+template <typename Fill>
+float StreamedMedianOfRows(size_t rows, int k, const Fill& fill) {
   constexpr int kShift = 16;
   constexpr size_t kBins = size_t{1} << (32 - kShift);
   auto bin = [](float v) {
@@ -31,10 +33,13 @@ float StreamedMedian(size_t n, const Value& value) {
 #pragma omp parallel
   {
     std::vector<uint64_t> own(kBins, 0);
+    std::vector<float> values(k);
 #pragma omp for schedule(static) nowait
-    for (size_t i = 0; i < n; ++i) {
-      const float v = value(i);
-      if (!std::isnan(v)) ++own[bin(v)];
+    for (size_t r = 0; r < rows; ++r) {
+      fill(r, values.data());
+      for (const float v : values) {
+        if (!std::isnan(v)) ++own[bin(v)];
+      }
     }
 #pragma omp critical
     for (size_t b = 0; b < kBins; ++b) histogram[b] += own[b];
@@ -50,17 +55,26 @@ float StreamedMedian(size_t n, const Value& value) {
   in_bin.reserve(histogram[median_bin]);
 #pragma omp parallel
   {
-    std::vector<float> own;
+    std::vector<float> own, values(k);
 #pragma omp for schedule(static) nowait
-    for (size_t i = 0; i < n; ++i) {
-      const float v = value(i);
-      if (!std::isnan(v) && bin(v) == median_bin) own.push_back(v);
+    for (size_t r = 0; r < rows; ++r) {
+      fill(r, values.data());
+      for (const float v : values) {
+        if (!std::isnan(v) && bin(v) == median_bin) own.push_back(v);
+      }
     }
 #pragma omp critical
     in_bin.insert(in_bin.end(), own.begin(), own.end());
   }
   std::nth_element(in_bin.begin(), in_bin.begin() + rank, in_bin.end());
   return in_bin[rank];
+}
+
+// Of the m values value(i), i < n, that are not NaN (all others >= 0), the
+// one at index m / 2 once sorted (StreamedMedianOfRows, one value a row).
+template <typename Value>
+float StreamedMedian(size_t n, const Value& value) {
+  return StreamedMedianOfRows(n, 1, [&](size_t i, float* out) { out[0] = value(i); });
 }
 
 }  // namespace sapmvs
