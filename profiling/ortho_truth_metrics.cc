@@ -256,7 +256,8 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
       }
       if (along.norm() < 1e-6) along = dirs[best];
       const Eigen::Vector2d q = p + across * along.normalized();
-      if (!(sign * (OrthoDsmHeight(dsm, q.x(), q.y()) - h0) > step)) continue;
+      const double hq = OrthoDsmHeight(dsm, q.x(), q.y());
+      if (!(sign * (hq - h0) > step)) continue;
       OrthoRgb other;
       if (!OrthoFootprint(truth, q.x(), q.y(), g.cell_size, &other)) continue;
       const OrthoRgb& own = truth_rgb[i];
@@ -270,8 +271,7 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
       if (ortho_dsm && std::abs(OrthoDsmHeight(*ortho_dsm, p.x(), p.y()) - h0) <= tolerance) {
         ++rows[row][4 + side];
         rows[row][4 + side + 1] += wrong;
-        if (std::abs(OrthoDsmHeight(*ortho_dsm, q.x(), q.y()) -
-                     OrthoDsmHeight(dsm, q.x(), q.y())) <= tolerance) {
+        if (std::abs(OrthoDsmHeight(*ortho_dsm, q.x(), q.y()) - hq) <= tolerance) {
           ++rows[row][8 + side];
           rows[row][8 + side + 1] += wrong;
         }

@@ -23,8 +23,16 @@ float Stored(const std::vector<float>& values) {
   return d[d.size() / 2];
 }
 
-float Streamed(const std::vector<float>& values) {
-  return StreamedMedian(values.size(), [&](size_t i) { return values[i]; });
+// The values in rows of k, as the filter hands them (a point's k
+// neighbours), the last row padded with NaN, which does not count.
+float Streamed(const std::vector<float>& values, int k = 1) {
+  const size_t rows = (values.size() + k - 1) / k;
+  return StreamedMedianOfRows(rows, k, [&](size_t r, float* out) {
+    for (int j = 0; j < k; ++j) {
+      const size_t i = r * k + j;
+      out[j] = i < values.size() ? values[i] : std::nanf("");
+    }
+  });
 }
 
 TEST(StreamedMedian, EqualsTheStoredSelectionOnOddAndEvenCounts) {
@@ -34,11 +42,14 @@ TEST(StreamedMedian, EqualsTheStoredSelectionOnOddAndEvenCounts) {
   for (const size_t n : {1u, 2u, 3u, 17u, 256u, 1001u, 65536u, 100003u}) {
     std::vector<float> v(n);
     for (float& x : v) x = unit(rng) < 0.3f ? std::nanf("") : spread(rng);
-    const float want = Stored(v), got = Streamed(v);
-    if (std::isnan(want)) {
-      EXPECT_TRUE(std::isnan(got)) << n << " values, all NaN";
-    } else {
-      EXPECT_EQ(got, want) << n << " values";
+    const float want = Stored(v);
+    for (const int k : {1, 16}) {
+      const float got = Streamed(v, k);
+      if (std::isnan(want)) {
+        EXPECT_TRUE(std::isnan(got)) << n << " values, all NaN, rows of " << k;
+      } else {
+        EXPECT_EQ(got, want) << n << " values, rows of " << k;
+      }
     }
   }
 }

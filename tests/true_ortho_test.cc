@@ -161,7 +161,7 @@ TEST(OrthoDepthBufferTest, TheBoxHidesTheGroundBehindIt) {
   const GeoRaster dsm = BoxDsm();
   // Low and west of the box: its west wall hides the ground just east of it.
   const Camera camera = NadirCamera({0, 30, 20});
-  const OrthoDepthBuffer depth(camera, dsm, {0, 0, 60, 60}, 1.0, 0.5);
+  const OrthoDepthBuffer depth(camera, dsm, {0, 0, 60, 60}, WallQuads(dsm, 1.0), 0.5);
   Eigen::Vector2d uv;
   EXPECT_TRUE(depth.Sees({15, 30, 0}, &uv));          // before the box
   EXPECT_TRUE(depth.Sees({30, 30, kBoxTop}, &uv));    // its roof
@@ -174,7 +174,7 @@ TEST(OrthoDepthBufferTest, TheBoxHidesTheGroundBehindIt) {
   // last half cell, and the ray would pass over it. (The camera puts the
   // point on a pixel's centre, where the depth is drawn.)
   const Camera above = NadirCamera({36.9, 30.4, 40});
-  const OrthoDepthBuffer over(above, dsm, {0, 0, 60, 60}, 1.0, 0.5);
+  const OrthoDepthBuffer over(above, dsm, {0, 0, 60, 60}, WallQuads(dsm, 1.0), 0.5);
   EXPECT_FALSE(over.Sees({21.3, 30, 0}, &uv));
   EXPECT_TRUE(over.Sees({25.5, 30, kBoxTop}, &uv));
   EXPECT_TRUE(depth.Sees({58, 50, 0}, &uv));  // beside its shadow

@@ -8,7 +8,8 @@
 namespace sapmvs {
 
 OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
-                                   const CellWindow& window, double step, double tolerance)
+                                   const CellWindow& window, const std::vector<uint8_t>& walls,
+                                   double tolerance)
     : camera_(camera),
       width_(camera.width()),
       height_(camera.height()),
@@ -83,13 +84,13 @@ OrthoDepthBuffer::OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm,
     project_row(r, &below);
     for (int i = 0; i + 1 < n; ++i) {
       const int col = window.col0 + i;
-      if (col + 1 < dsm.width && QuadSpan(dsm, col, r - 1) > step) {
+      if (col + 1 < dsm.width && walls[static_cast<size_t>(r - 1) * dsm.width + col]) {
         draw_blocks(col, r - 1, {above[i], above[i + 1], below[i], below[i + 1]});
         continue;
       }
       const Eigen::Vector3d &a = above[i], &b = above[i + 1], &c = below[i], &d = below[i + 1];
-      if (a.z() > 0 && b.z() > 0 && c.z() > 0) DrawTriangle(a, b, c);
-      if (b.z() > 0 && d.z() > 0 && c.z() > 0) DrawTriangle(b, d, c);
+      draw(a, b, c);
+      draw(b, d, c);
       // A quad with one empty corner keeps the triangle of the other three.
       if (a.z() > 0 && b.z() > 0 && d.z() > 0 && !(c.z() > 0)) DrawTriangle(a, b, d);
       if (a.z() > 0 && d.z() > 0 && c.z() > 0 && !(b.z() > 0)) DrawTriangle(a, d, c);

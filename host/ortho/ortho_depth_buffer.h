@@ -6,6 +6,7 @@
 // without holes between the cells; where those four heights span a step,
 // as blocks: each cell flat to its sides, walls between.
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "ortho/ortho_surface.h"
@@ -17,12 +18,12 @@ namespace sapmvs {
 class OrthoDepthBuffer {
  public:
   // Draws the cells of `dsm` in `window` as `camera` (a pinhole camera, the
-  // image's at the level) sees them, as blocks where four heights span more
-  // than `step` (OrthoSurface::step). A point counts as seen when it lies at
-  // most `tolerance` (CRS units) behind the drawn surface: a point on the
+  // image's at the level) sees them, as blocks where `walls` (WallQuads of
+  // `dsm`) marks the quad. A point counts as seen when it lies at most
+  // `tolerance` (CRS units) behind the drawn surface: a point on the
   // surface, tested at the nearest pixel, must not hide itself.
   OrthoDepthBuffer(const Camera& camera, const GeoRaster& dsm, const CellWindow& window,
-                   double step, double tolerance);
+                   const std::vector<uint8_t>& walls, double tolerance);
 
   // Whether world point `x` is in the image and not hidden; its pixel in
   // `uv` then.

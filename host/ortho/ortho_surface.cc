@@ -117,17 +117,23 @@ void FindObjects(const GeoRaster& dsm, double object_slope, double margin, Ortho
 
 }  // namespace
 
-double QuadSpan(const GeoRaster& dsm, int col, int row) {
-  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-  for (int dr = 0; dr < 2; ++dr) {
-    for (int dc = 0; dc < 2; ++dc) {
-      const int c = col + dc, r = row + dr;
-      if (c >= dsm.width || r >= dsm.height || dsm.IsEmpty(c, r)) continue;
-      lo = std::min(lo, dsm.at(c, r));
-      hi = std::max(hi, dsm.at(c, r));
+std::vector<uint8_t> WallQuads(const GeoRaster& dsm, double step) {
+  std::vector<uint8_t> walls(dsm.values.size(), 0);
+  ParallelFor(dsm.height, [&](long r) {
+    for (int c = 0; c < dsm.width; ++c) {
+      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      for (int dr = 0; dr < 2; ++dr) {
+        for (int dc = 0; dc < 2; ++dc) {
+          const int cc = c + dc, rr = static_cast<int>(r) + dr;
+          if (cc >= dsm.width || rr >= dsm.height || dsm.IsEmpty(cc, rr)) continue;
+          lo = std::min(lo, dsm.at(cc, rr));
+          hi = std::max(hi, dsm.at(cc, rr));
+        }
+      }
+      walls[static_cast<size_t>(r) * dsm.width + c] = hi - lo > step;
     }
-  }
-  return hi > lo ? hi - lo : 0.0;
+  });
+  return walls;
 }
 
 long FillEnclosedHoles(GeoRaster* dsm) {
@@ -138,6 +144,8 @@ long FillEnclosedHoles(GeoRaster* dsm) {
   for (int r = 0; r < h; ++r) {
     for (int c = 0; c < w; ++c) empty.at<uint8_t>(r + 1, c + 1) = dsm->IsEmpty(c, r) ? 255 : 0;
   }
+  // Every empty cell, for the distances to the valid ones below.
+  const cv::Mat invalid = empty.clone();
   cv::floodFill(empty, cv::Point(0, 0), cv::Scalar(0));
   cv::Mat labels;
   const int n = cv::connectedComponents(empty, labels, 4, CV_32S);
@@ -161,12 +169,7 @@ long FillEnclosedHoles(GeoRaster* dsm) {
   }
   // The nearest valid cell of each empty one (its label's), for the cells
   // at a hole's rim.
-  cv::Mat invalid(h + 2, w + 2, CV_8U, cv::Scalar(255)), distance, nearest;
-  for (int r = 0; r < h; ++r) {
-    for (int c = 0; c < w; ++c) {
-      if (!dsm->IsEmpty(c, r)) invalid.at<uint8_t>(r + 1, c + 1) = 0;
-    }
-  }
+  cv::Mat distance, nearest;
   cv::distanceTransform(invalid, distance, nearest, cv::DIST_L2, cv::DIST_MASK_5,
                         cv::DIST_LABEL_PIXEL);
   std::vector<float> height_of(static_cast<size_t>(h) * w + 1,
@@ -214,7 +217,8 @@ OrthoSurface MakeOrthoSurface(const GeoRaster& source, double cell, double objec
   g.values.resize(static_cast<size_t>(g.width) * g.height);
   s.dsm_col.resize(g.width);
   s.dsm_row.resize(g.height);
-  s.step = kWallSlope * dsm.cell_size;
+  const double step = kWallSlope * dsm.cell_size;
+  s.walls = WallQuads(dsm, step);
   for (int c = 0; c < g.width; ++c) {
     s.dsm_col[c] = std::min(dsm.width - 1, static_cast<int>((c + 0.5) * cell / dsm.cell_size));
   }
@@ -224,7 +228,7 @@ OrthoSurface MakeOrthoSurface(const GeoRaster& source, double cell, double objec
   ParallelFor(g.height, [&](long r) {
     for (int c = 0; c < g.width; ++c) {
       const Eigen::Vector2d p = g.CellCenter(c, static_cast<int>(r));
-      g.at(c, static_cast<int>(r)) = InterpolateHeight(dsm, p.x(), p.y(), s.step);
+      g.at(c, static_cast<int>(r)) = InterpolateHeight(dsm, p.x(), p.y(), step);
     }
   });
   s.zmin = std::numeric_limits<double>::infinity();

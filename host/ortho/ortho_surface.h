@@ -3,6 +3,7 @@
 // objects (buildings, trees) that must each come from one image, and the
 // part of the grid an image can see.
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "sapmvs/block/camera.h"
@@ -27,18 +28,18 @@ struct OrthoSurface {
   // The DSM cell under each ortho column and row.
   std::vector<int> dsm_col, dsm_row;
   double zmin = 0, zmax = 0;  // the DSM's height range
-  // Heights that differ by more than this from one cell to the next are a
-  // wall, CRS units.
-  double step = 0;
+  // WallQuads of `dsm`: where the depth buffers draw walls.
+  std::vector<uint8_t> walls;
 
   int ObjectAt(int col, int row) const {
     return dsm_object[static_cast<size_t>(dsm_row[row]) * dsm.width + dsm_col[col]];
   }
 };
 
-// The range of the heights of the valid cells among (col, row) and its
-// neighbours east, south and south-east: 0 for fewer than two.
-double QuadSpan(const GeoRaster& dsm, int col, int row);
+// Per quad of `dsm` (cells (c, r) to (c + 1, r + 1), at r * width + c): 1
+// where the heights of its valid cells span more than `step`, a wall that
+// the depth buffers draw as blocks (OrthoDepthBuffer), else 0.
+std::vector<uint8_t> WallQuads(const GeoRaster& dsm, double step);
 
 // Fills each hole of `dsm` that the valid cells enclose with a low height
 // of its rim (the 10th percentile): such holes are mostly ground that few

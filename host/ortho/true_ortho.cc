@@ -189,7 +189,7 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
       static_cast<long>(views.size()),
       [&](long k) {
         const OrthoView& v = views[k];
-        const OrthoDepthBuffer depth(v.camera, dsm, v.dsm_cells, surface.step, tolerance);
+        const OrthoDepthBuffer depth(v.camera, dsm, v.dsm_cells, surface.walls, tolerance);
         for (int r = v.dsm_cells.row0; r < v.dsm_cells.row1; ++r) {
           for (int c = v.dsm_cells.col0; c < v.dsm_cells.col1; ++c) {
             if (dsm.IsEmpty(c, r)) continue;
@@ -256,7 +256,7 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
           const OrthoView& v = views[used_views[first + j]];
           const LoadedImage image = LoadUndistorted(block.images[v.image]);
           loaded[j] = ResampleToLevel(image.pixels, level, v.camera.width(), v.camera.height());
-          depths[j] = std::make_unique<OrthoDepthBuffer>(v.camera, dsm, v.dsm_cells, surface.step,
+          depths[j] = std::make_unique<OrthoDepthBuffer>(v.camera, dsm, v.dsm_cells, surface.walls,
                                                          tolerance);
         },
         1);

@@ -70,11 +70,4 @@ float StreamedMedianOfRows(size_t rows, int k, const Fill& fill) {
   return in_bin[rank];
 }
 
-// Of the m values value(i), i < n, that are not NaN (all others >= 0), the
-// one at index m / 2 once sorted (StreamedMedianOfRows, one value a row).
-template <typename Value>
-float StreamedMedian(size_t n, const Value& value) {
-  return StreamedMedianOfRows(n, 1, [&](size_t i, float* out) { out[0] = value(i); });
-}
-
 }  // namespace sapmvs
