@@ -31,6 +31,8 @@ nlohmann::json ToJson(const OrthoTruth& r, const std::string& ortho) {
   auto side = [](const EdgeSide& s) {
     return nlohmann::json{{"cells", s.cells}, {"wrong", s.wrong}, {"share", s.Share()}};
   };
+  nlohmann::json tiles = nlohmann::json::array();
+  for (const auto& t : r.tile_shifts) tiles.push_back({t.col, t.row, t.east, t.north});
   return {{"ortho", ortho},
           {"gsd", r.gsd},
           {"ortho_cell", r.ortho_cell},
@@ -47,6 +49,7 @@ nlohmann::json ToJson(const OrthoTruth& r, const std::string& ortho) {
           {"shift_p95_gsd", r.shift_p95},
           {"shift_east_gsd", r.shift_east},
           {"shift_north_gsd", r.shift_north},
+          {"tile_shifts", tiles},  // [column, row, east, north]: GSDs
           {"ghost_high", side(r.high)},
           {"ghost_low", side(r.low)},
           {"ghost_high_dsm_right", side(r.high_right)},

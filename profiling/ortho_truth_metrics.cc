@@ -181,6 +181,7 @@ void OrthoShifts(const ColorRaster& ortho, const std::vector<OrthoRgb>& truth_rg
       shifts.push_back(std::hypot(d.x, d.y) * to_gsd);
       east.push_back(d.x * to_gsd);
       north.push_back(0.0 - d.y * to_gsd);  // 0 - 0 is +0: no "-0.00" for no shift
+      out->tile_shifts.push_back({tx, ty, east.back(), north.back()});
     }
   }
   out->shift_median = OrthoQuantile(shifts, 0.5);

@@ -122,6 +122,13 @@ struct OrthoTruth {
   // and the median shift east and north (signed).
   int tiles = 0, tiles_used = 0;
   double shift_median = 0, shift_p95 = 0, shift_east = 0, shift_north = 0;
+  // Each used tile's north-west ortho cell (column, row) and its shift east
+  // and north in truth GSDs, to find the tiles behind a high percentile.
+  struct TileShift {
+    int col = 0, row = 0;
+    double east = 0, north = 0;
+  };
+  std::vector<TileShift> tile_shifts;
   EdgeSide high, low;  // roofs and crowns; the ground beside them
   // The same, of the edge cells where the ortho's DSM is right (with one);
   // and of those where it is right on the other side too: where the DSM has
