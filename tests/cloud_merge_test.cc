@@ -223,6 +223,93 @@ TEST(CloudMerge, BothGroupsAreKeptWithinTheBlendBandOfTheirBorder) {
   for (const MergedRef& r : MergeGroupRefs(groups, o)) EXPECT_TRUE(r.core);
 }
 
+// Two groups matched the ground (z = 100) on both sides of their border at
+// x = 10, with normals up; `cluster` is added to a's points.
+std::vector<MergedRef> MergeWithCluster(const PointCloud& cluster, const MergeOptions& o,
+                                        PointCloud* a, PointCloud* b, MergeStats* st) {
+  const double s = 0.1;
+  *a = Grid(5, 15, 0, 4, s, 0, 0, 100, 0.5f);
+  *b = Grid(5, 15, 0, 4, s, s / 2, s / 2, 100.02, 0.9f);
+  a->points.insert(a->points.end(), cluster.points.begin(), cluster.points.end());
+  for (PointCloud* c : {a, b}) {
+    c->has_normals = true;
+    for (CloudPoint& p : c->points) {
+      if (p.normal.isZero()) p.normal = Eigen::Vector3f::UnitZ();
+    }
+  }
+  std::vector<GroupCloud> groups = {{a, {500005.0, 5400002.0}}, {b, {500015.0, 5400002.0}}};
+  return MergeGroupRefs(groups, o, st);
+}
+
+// How many of `refs` are group 0's points from `first` on (the cluster).
+long KeptFrom(const std::vector<MergedRef>& refs, size_t first) {
+  return std::count_if(refs.begin(), refs.end(),
+                       [&](const MergedRef& r) { return r.group == 0 && r.index >= first; });
+}
+
+TEST(CloudMerge, AClusterUnderTheGroundByABorderIsVotedOut) {
+  // a matched a patch 1.5 m under the ground, within a few radii of the
+  // border: the blend band keeps it, and the other group's ground lies
+  // beyond surface_depth_radii of it, so the duplicate test cannot see it.
+  MergeOptions o;
+  o.radius = 0.1;
+  o.blend_radii = 2;
+  const size_t first = Grid(5, 15, 0, 4, 0.1, 0, 0, 100, 0.5f).points.size();
+  auto cluster_at = [](double x0, double height, const Eigen::Vector3f& normal) {
+    PointCloud c = Grid(x0, x0 + 0.3, 1.8, 2.1, 0.1, 0, 0, height, 0.95f);
+    for (CloudPoint& p : c.points) p.normal = normal;
+    return c;
+  };
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  const PointCloud by_border = cluster_at(9.9, 98.5, up);
+  PointCloud a, b;
+  MergeStats st;
+  EXPECT_EQ(KeptFrom(MergeWithCluster(by_border, o, &a, &b, &st), first), 0);
+  EXPECT_EQ(st.band_outliers, static_cast<long>(by_border.points.size()));
+  // Without the vote it stays; far from the border it is the group's own
+  // affair (its filter's); a tilted patch amid the ground goes too.
+  o.vote_zone_radii = 0;
+  EXPECT_EQ(KeptFrom(MergeWithCluster(by_border, o, &a, &b, &st), first),
+            static_cast<long>(by_border.points.size()));
+  EXPECT_EQ(st.band_outliers, 0);
+  o.vote_zone_radii = 40;
+  const PointCloud far = cluster_at(5.2, 98.5, up);
+  EXPECT_EQ(KeptFrom(MergeWithCluster(far, o, &a, &b, &st), first),
+            static_cast<long>(far.points.size()));
+  const PointCloud tilted = cluster_at(9.9, 98.5, Eigen::Vector3f(1, 0, 0.3f).normalized());
+  EXPECT_EQ(KeptFrom(MergeWithCluster(tilted, o, &a, &b, &st), first), 0);
+}
+
+TEST(CloudMerge, TheVoteLeavesCrownsAndWallsByABorder) {
+  MergeOptions o;
+  o.radius = 0.1;
+  o.blend_radii = 2;
+  const size_t first = Grid(5, 15, 0, 4, 0.1, 0, 0, 100, 0.5f).points.size();
+  // A crown 8 m over the ground (beyond the vote's reach of 6 m): another
+  // surface, not a wrong match of this one.
+  PointCloud crown = Grid(9.8, 10.2, 1.8, 2.2, 0.05, 0, 0, 108, 0.95f);
+  PointCloud a, b;
+  MergeStats st;
+  EXPECT_EQ(KeptFrom(MergeWithCluster(crown, o, &a, &b, &st), first),
+            static_cast<long>(crown.points.size()));
+  // A wall 3 m high along y = 2, facing south: its points' columns hold the
+  // wall above and below them, which does not vote; the ground at its foot
+  // stays too.
+  PointCloud wall;
+  for (double z = 100.05; z < 103; z += 0.05) {
+    for (double x = 9.8; x < 10.2; x += 0.05) {
+      CloudPoint p;
+      p.position = {500000.0 + x, 5400002.0, z};
+      p.normal = -Eigen::Vector3f::UnitY();
+      p.score = 0.9f;
+      wall.points.push_back(p);
+    }
+  }
+  const std::vector<MergedRef> kept = MergeWithCluster(wall, o, &a, &b, &st);
+  EXPECT_EQ(KeptFrom(kept, first), static_cast<long>(wall.points.size()));
+  EXPECT_EQ(st.band_outliers, 0);
+}
+
 TEST(CloudMerge, SurfacesAtOtherHeightsAreNotDuplicates) {
   // A roof 5 m above the ground seen by another group is another surface.
   const PointCloud a = Grid(0, 5, 0, 5, 0.5, 0, 0, 100, 0.9f);
@@ -357,6 +444,19 @@ TEST(CloudMerge, BadRadiusIsAnError) {
     EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
   }
   o.blend_radii = 0;
+  for (const double k : {-1.0, std::nan("")}) {
+    o.vote_zone_radii = k;
+    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
+  }
+  o.vote_zone_radii = 40;
+  for (const double k : {0.0, std::nan("")}) {
+    o.vote_column_radii = k;
+    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
+  }
+  o.vote_column_radii = 6;
+  o.vote_reach_depths = 0.5;
+  EXPECT_THROW(MergeGroupClouds(groups, o), Error);
+  o.vote_reach_depths = 6;
   EXPECT_NO_THROW(MergeGroupClouds(groups, o));
 }
 

@@ -278,6 +278,7 @@ std::string Merge(const json& r) {
          Row("Cross-group duplicates dropped",
              GroupedInteger(duplicates) +
                  (input > 0 ? " (" + Decimal(100 * duplicates / input, 1) + " %)" : "")) +
+         Row("Off the surface by a border, dropped", GroupedInteger(Num(m, "band_outliers"))) +
          Row("Seams levelled", GroupedInteger(Num(m, "seams_levelled"))) +
          Row("Median seam offset", Decimal(Num(m, "seam_offset"), 3)) + "</table>";
 }

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <optional>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 #include "sapmvs/run/core_index.h"
@@ -40,6 +41,16 @@ std::string MergeOptions::Problem() const {
   if (!(std::isfinite(surface_depth_radii) && surface_depth_radii >= 0)) {
     std::ostringstream s;
     s << "a surface depth >= 0 radii (surface_depth_radii = " << surface_depth_radii << ")";
+    return s.str();
+  }
+  if (!(std::isfinite(vote_zone_radii) && vote_zone_radii >= 0 &&
+        std::isfinite(vote_column_radii) && vote_column_radii > 0 &&
+        std::isfinite(vote_reach_depths) && vote_reach_depths >= 1)) {
+    std::ostringstream s;
+    s << "a vote zone >= 0, a vote column > 0 radii and a vote reach >= 1 depth "
+         "(vote_zone_radii = "
+      << vote_zone_radii << ", vote_column_radii = " << vote_column_radii
+      << ", vote_reach_depths = " << vote_reach_depths << ")";
     return s.str();
   }
   if (tile_points < 1000)
@@ -191,11 +202,126 @@ std::vector<uint8_t> MayHaveForeignNeighbour(const std::vector<GroupCloud>& grou
   return may;
 }
 
+// A kept point near a border, for the column vote: where it sits in the
+// merge's order, and how far it lies from its core's border.
+struct NearBorder {
+  Ref ref;
+  size_t slot;
+  double border;
+};
+
+// Whether a unit or zero normal (unknown) faces up or down enough for its
+// point to lie on a surface a vertical column cuts (MergeOptions::vote_*).
+bool FacesUpOrDown(const Eigen::Vector3f& n) {
+  return n.squaredNorm() < 0.5f || std::abs(n.z()) >= 0.5f;
+}
+
+template <typename PointOf>
+void VoteNearBorders(const std::vector<NearBorder>& near, const PointOf& point, double zone,
+                     double column, double deep, double reach, std::vector<uint8_t>* drop) {
+  // The points copied in column order, each column's a contiguous range:
+  // through the groups' clouds, each voter was a cache miss.
+  struct Voter {
+    Eigen::Vector3d position;
+    uint32_t near;  // index into `near`
+    bool up;        // FacesUpOrDown
+  };
+  auto key = [&](const Eigen::Vector3d& p) {
+    return CellKey{static_cast<int64_t>(std::floor(p.x() / column)),
+                   static_cast<int64_t>(std::floor(p.y() / column)), 0};
+  };
+  std::vector<std::pair<CellKey, uint32_t>> keyed(near.size());
+  for (size_t i = 0; i < near.size(); ++i) {
+    keyed[i] = {key(point(near[i].ref).position), static_cast<uint32_t>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.first.x, a.first.y, a.second) < std::tie(b.first.x, b.first.y, b.second);
+  });
+  struct Column {
+    uint32_t begin, end;
+    double low, high;  // of its voters' heights
+  };
+  std::vector<Voter> voters(near.size());
+  std::unordered_map<CellKey, Column, CellHash> columns;
+  for (size_t k = 0; k < keyed.size(); ++k) {
+    const CloudPoint& p = point(near[keyed[k].second].ref);
+    voters[k] = {p.position, keyed[k].second, FacesUpOrDown(p.normal)};
+    const double z = p.position.z();
+    auto [it, fresh] = columns.try_emplace(
+        keyed[k].first, Column{static_cast<uint32_t>(k), static_cast<uint32_t>(k + 1), z, z});
+    if (!fresh) {
+      it->second.end = static_cast<uint32_t>(k + 1);
+      it->second.low = std::min(it->second.low, z);
+      it->second.high = std::max(it->second.high, z);
+    }
+  }
+  // Where the 3 x 3 columns around one hold heights within `deep` of each
+  // other, no median can lie further from any of them: most of the ground,
+  // skipped without a look at each pair.
+  std::vector<std::pair<uint32_t, uint32_t>> unsettled;
+  for (const auto& [at, c] : columns) {
+    double low = c.low, high = c.high;
+    for (int64_t x = at.x - 1; x <= at.x + 1; ++x) {
+      for (int64_t y = at.y - 1; y <= at.y + 1; ++y) {
+        const auto it = columns.find(CellKey{x, y, 0});
+        if (it == columns.end()) continue;
+        low = std::min(low, it->second.low);
+        high = std::max(high, it->second.high);
+      }
+    }
+    if (high - low > deep) unsettled.emplace_back(c.begin, c.end);
+  }
+  std::vector<uint32_t> judged;
+  for (const auto& [begin, end] : unsettled) {
+    for (uint32_t k = begin; k < end; ++k) {
+      if (near[voters[k].near].border < zone) judged.push_back(k);
+    }
+  }
+  std::sort(judged.begin(), judged.end());
+  const double column2 = column * column;
+#pragma omp parallel
+  {
+    std::vector<double> dz;
+#pragma omp for schedule(dynamic, 256)
+    for (size_t i = 0; i < judged.size(); ++i) {
+      const uint32_t k = judged[i];
+      const Voter& v = voters[k];
+      const Eigen::Vector3d& p = v.position;
+      dz.clear();
+      size_t steep = 0;
+      const CellKey at = keyed[k].first;
+      for (int64_t x = at.x - 1; x <= at.x + 1; ++x) {
+        for (int64_t y = at.y - 1; y <= at.y + 1; ++y) {
+          const auto it = columns.find(CellKey{x, y, 0});
+          if (it == columns.end()) continue;
+          for (uint32_t j = it->second.begin; j < it->second.end; ++j) {
+            const Eigen::Vector3d d = voters[j].position - p;
+            if (d.x() * d.x() + d.y() * d.y() > column2 || std::abs(d.z()) > reach) continue;
+            if (voters[j].up) {
+              dz.push_back(d.z());
+            } else {
+              ++steep;
+            }
+          }
+        }
+      }
+      // Only the surfaces a vertical column cuts vote: a wall's points above
+      // the ground at its foot would outvote it. A steep point is judged only
+      // among them (a wrong match on open ground), not on a wall or a facade.
+      if (dz.empty() || (!v.up && steep * 3 > dz.size())) continue;
+      const auto mid = dz.begin() + static_cast<long>(dz.size() / 2);
+      std::nth_element(dz.begin(), mid, dz.end());
+      (*drop)[near[v.near].slot] = std::abs(*mid) > deep;
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
                                       const MergeOptions& options, MergeStats* stats,
-                                      const CoreIndex* cores) {
+                                      const CoreIndex* cores,
+                                      std::vector<MergedRef>* band_outliers) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("merge: expected " + problem);
   MergeStats local;
@@ -228,11 +354,12 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     bool contested;  // MayHaveForeignNeighbour
     bool blend;      // within options.blend_radii of its core's border
     float score;
+    float border;  // distance to its core's border (0 without a blend band)
   };
   const double wide = options.radius * options.outside_core_radii;
   const double blend_width = options.radius * options.blend_radii;
   std::optional<CoreIndex> own_cores;
-  if (!cores) cores = &own_cores.emplace(centers, blend_width);
+  if (!cores) cores = &own_cores.emplace(centers, options.BorderReach());
   // A point outside its core is judged within `wide` of its normal line and
   // `deep` along it: the corners of that cylinder are `reach` away.
   const double deep = options.radius * options.surface_depth_radii;
@@ -250,14 +377,12 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     for (size_t i = 0; i < pts.size(); ++i) {
       // The distance to the border only where a blend band asks for it.
       const double x = pts[i].position.x(), y = pts[i].position.y();
-      const auto [owner, border] =
-          blend_width > 0 ? cores->OwnerAndBorder({x, y}) : std::pair{cores->Owner({x, y}), 0.0};
+      const auto [owner, border] = options.BorderReach() > 0 ? cores->OwnerAndBorder({x, y})
+                                                             : std::pair{cores->Owner({x, y}), 0.0};
       const bool core = owner == static_cast<int>(g);
-      items[flat + i] = {{static_cast<int>(g), i},
-                         core,
-                         (core ? contested : contested_far)[flat + i] != 0,
-                         border < blend_width,
-                         pts[i].score};
+      items[flat + i] = {
+          {static_cast<int>(g), i}, core,         (core ? contested : contested_far)[flat + i] != 0,
+          border < blend_width,     pts[i].score, static_cast<float>(border)};
     }
     flat += pts.size();
   }
@@ -273,6 +398,10 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   // Core points are looked up within the radius, the others within `wide`,
   // each in a grid of its own reach (RadiusGrid looks one cube around).
   RadiusGrid<Ref> kept(options.radius), kept_wide(reach);
+  // Kept points near a border, for the column vote.
+  const double vote_zone = options.radius * options.vote_zone_radii;
+  const double vote_column = options.radius * options.vote_column_radii;
+  std::vector<NearBorder> near;
   for (const Item& item : items) {
     if (item.contested) {
       const Eigen::Vector3d& p = point(item.ref).position;
@@ -297,9 +426,32 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
       kept.Insert(p, item.ref);
       kept_wide.Insert(p, item.ref);
     }
+    if (vote_zone > 0 && item.border < vote_zone + vote_column) {
+      near.push_back({item.ref, order.size(), item.border});
+    }
     order.push_back({item.ref.group, item.ref.index, item.core});
-    ++st.kept_by_group[item.ref.group];
-    if (item.core) ++st.core_by_group[item.ref.group];
+  }
+  if (!near.empty()) {
+    std::vector<uint8_t> drop(order.size(), 0);
+    VoteNearBorders(
+        near, [&](const Ref& r) -> const CloudPoint& { return point(r); }, vote_zone, vote_column,
+        deep, options.vote_reach_depths* deep, &drop);
+    std::vector<MergedRef> dropped;
+    size_t to = 0;
+    for (size_t i = 0; i < order.size(); ++i) {
+      if (drop[i]) {
+        dropped.push_back(order[i]);
+      } else {
+        order[to++] = order[i];
+      }
+    }
+    order.resize(to);
+    st.band_outliers = static_cast<long>(dropped.size());
+    if (band_outliers) *band_outliers = std::move(dropped);
+  }
+  for (const MergedRef& ref : order) {
+    ++st.kept_by_group[ref.group];
+    if (ref.core) ++st.core_by_group[ref.group];
   }
   // Output in group order, each group's points in their original order, so
   // that the merged file does not depend on score ties.

@@ -398,7 +398,11 @@ void PrintRunSummary(const RunReport& report, std::ostream& out) {
     return;
   }
   out << "merge         " << report.merge.input << " -> " << report.points << " points ("
-      << report.merge.duplicates << " cross-group duplicates dropped"
+      << report.merge.duplicates << " cross-group duplicates"
+      << (report.merge.band_outliers > 0
+              ? ", " + std::to_string(report.merge.band_outliers) + " off the border's surface"
+              : "")
+      << " dropped"
       << (report.merge_tiles > 1 ? ", " + std::to_string(report.merge_tiles) + " tiles" : "")
       << ")\n";
   out << "\n";

@@ -184,6 +184,7 @@ void WriteRunReport(const RunOptions& options, const RunReport& report, const Bl
   j["merge"] = {{"input", report.merge.input},
                 {"kept", report.merge.kept},
                 {"cross_group_duplicates", report.merge.duplicates},
+                {"band_outliers", report.merge.band_outliers},
                 {"seams_levelled", report.merge.seam_pairs},
                 {"seam_offset", report.merge.seam_offset},
                 {"tiles", report.merge_tiles}};

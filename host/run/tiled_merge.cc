@@ -138,11 +138,11 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
   for (size_t g = 0; g < n; ++g) centers[g] = groups[g].center;
   // Once for all tiles: over the block's extent, a grid cell per quarter of
   // a group's ground.
-  const CoreIndex cores(std::move(centers), options.radius * options.blend_radii,
-                        {block.xmin, block.ymin}, {block.xmax, block.ymax});
+  const CoreIndex cores(std::move(centers), options.BorderReach(), {block.xmin, block.ymin},
+                        {block.xmax, block.ymax});
   struct TileOut {
     PointCloud points;
-    long input = 0;
+    long input = 0, band_outliers = 0;
     std::vector<long> kept_by_group, core_by_group;
   };
   auto merge_tile = [&](int tx, int ty) {
@@ -187,7 +187,12 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
     out.kept_by_group.assign(n, 0);
     out.core_by_group.assign(n, 0);
     MergeStats tile_stats;
-    std::vector<MergedRef> refs = MergeGroupRefs(parts, options, &tile_stats, &cores);
+    std::vector<MergedRef> band_outliers;
+    std::vector<MergedRef> refs =
+        MergeGroupRefs(parts, options, &tile_stats, &cores, &band_outliers);
+    for (const MergedRef& ref : band_outliers) {
+      out.band_outliers += own(clouds[ref.group].points[ref.index]);
+    }
     out.points = layout.format;
     out.points.points.reserve(
         static_cast<size_t>(std::count_if(refs.begin(), refs.end(), [&](const MergedRef& ref) {
@@ -236,7 +241,9 @@ MergeStats MergeInTiles(const std::vector<MergeSource>& groups, const MergeOptio
       if (launched < order.size()) launch();
       st.input += tile.input;
       st.kept += static_cast<long>(tile.points.points.size());
-      st.duplicates += tile.input - static_cast<long>(tile.points.points.size());
+      st.duplicates +=
+          tile.input - static_cast<long>(tile.points.points.size()) - tile.band_outliers;
+      st.band_outliers += tile.band_outliers;
       for (size_t g = 0; g < n; ++g) {
         st.kept_by_group[g] += tile.kept_by_group[g];
         st.core_by_group[g] += tile.core_by_group[g];
