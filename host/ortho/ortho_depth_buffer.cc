@@ -120,13 +120,43 @@ void OrthoDepthBuffer::DrawTriangle(const Eigen::Vector3d& a, const Eigen::Vecto
   const double wb0 = (x0 - a.x()) * bx + (y0 - a.y()) * by;
   const double wc0 = (x0 - a.x()) * cx + (y0 - a.y()) * cy;
   constexpr double kEdge = -1e-9;
+  // Each row's run of pixels inside: the three weights are affine in x, so
+  // each bounds x on one side. A thin triangle across the image (a wall
+  // seen from the side) covers a sliver of its bounding box, and testing
+  // every pixel of the box took most of a facade block's ortho time. The
+  // run is widened by a pixel each way and every pixel still tested, so
+  // that rounding in the bounds never loses one. A box a few pixels wide
+  // (a nadir block's cells) is tested whole: there the bounds cost more than
+  // the pixels they spare (Caliterra's ortho 5.7-6.0 s against 5.0-5.1 s).
+  constexpr int kClipSpan = 8;
+  const int span = x1 - x0;
+  auto clip = [&](double f0, double fx, double* lo, double* hi) {  // f0 + t fx >= 0
+    if (fx > 0) {
+      *lo = std::max(*lo, -f0 / fx);
+    } else if (fx < 0) {
+      *hi = std::min(*hi, -f0 / fx);
+    } else if (f0 < 0) {
+      *hi = -1;
+    }
+  };
   for (int y = y0; y <= y1; ++y) {
-    double wb = wb0 + (y - y0) * by, wc = wc0 + (y - y0) * cy;
-    float* row = &depth_[static_cast<size_t>(y) * width_];
-    for (int x = x0; x <= x1; ++x, wb += bx, wc += cx) {
-      if (wb < kEdge || wc < kEdge || wb + wc > 1 - kEdge) continue;
-      const float z = static_cast<float>(1 / (ia + wb * ib + wc * ic));
-      row[x] = std::min(row[x], z);
+    const double wb = wb0 + (y - y0) * by, wc = wc0 + (y - y0) * cy;
+    int t0 = 0, t1 = span;
+    if (span >= kClipSpan) {
+      double lo = 0, hi = span;
+      clip(wb - kEdge, bx, &lo, &hi);
+      clip(wc - kEdge, cx, &lo, &hi);
+      clip(1 - kEdge - wb - wc, -(bx + cx), &lo, &hi);
+      if (lo > hi + 2) continue;
+      t0 = std::max(0, static_cast<int>(std::floor(lo)) - 1);
+      t1 = std::min(span, static_cast<int>(std::ceil(hi)) + 1);
+    }
+    float* row = &depth_[static_cast<size_t>(y) * width_ + x0];
+    for (int t = t0; t <= t1; ++t) {
+      const double b = wb + t * bx, c = wc + t * cx;
+      if (b < kEdge || c < kEdge || b + c > 1 - kEdge) continue;
+      const float z = static_cast<float>(1 / (ia + b * ib + c * ic));
+      row[t] = std::min(row[t], z);
     }
   }
 }
