@@ -202,63 +202,59 @@ std::vector<uint8_t> MayHaveForeignNeighbour(const std::vector<GroupCloud>& grou
   return may;
 }
 
-// A kept point near a border, for the column vote: where it sits in the
-// merge's order, and how far it lies from its core's border.
-struct NearBorder {
-  Ref ref;
-  size_t slot;
-  double border;
-};
-
 // Whether a unit or zero normal (unknown) faces up or down enough for its
 // point to lie on a surface a vertical column cuts (MergeOptions::vote_*).
 bool FacesUpOrDown(const Eigen::Vector3f& n) {
   return n.squaredNorm() < 0.5f || std::abs(n.z()) >= 0.5f;
 }
 
-template <typename PointOf>
-void VoteNearBorders(const std::vector<NearBorder>& near, const PointOf& point, double zone,
-                     double column, double deep, double reach, std::vector<uint8_t>* drop) {
-  // The points copied in column order, each column's a contiguous range:
-  // through the groups' clouds, each voter was a cache miss.
-  struct Voter {
-    Eigen::Vector3d position;
-    uint32_t near;  // index into `near`
-    bool up;        // FacesUpOrDown
-  };
+// A kept point near a border, for the column vote: where it sits in the
+// merge's order, how far it lies from its core's border, and whether it
+// votes (FacesUpOrDown). 40 bytes: a tile's near points are held at once,
+// and on Caliterra they set the run's peak.
+struct Voter {
+  Eigen::Vector3d position;
+  uint32_t slot;
+  float border;
+  bool up;
+};
+
+// MergeOptions::vote_zone_radii: marks in `drop` (by slot) the points within
+// `zone` of a border whose column's median height lies more than `deep`
+// from theirs. Sorts `voters` by column.
+void VoteNearBorders(std::vector<Voter>* voters, double zone, double column, double deep,
+                     double reach, std::vector<uint8_t>* drop) {
   auto key = [&](const Eigen::Vector3d& p) {
     return CellKey{static_cast<int64_t>(std::floor(p.x() / column)),
                    static_cast<int64_t>(std::floor(p.y() / column)), 0};
   };
-  std::vector<std::pair<CellKey, uint32_t>> keyed(near.size());
-  for (size_t i = 0; i < near.size(); ++i) {
-    keyed[i] = {key(point(near[i].ref).position), static_cast<uint32_t>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) {
-    return std::tie(a.first.x, a.first.y, a.second) < std::tie(b.first.x, b.first.y, b.second);
+  // Each column's points a contiguous range: through the groups' clouds,
+  // every voter was a cache miss.
+  std::sort(voters->begin(), voters->end(), [&](const Voter& a, const Voter& b) {
+    const CellKey ka = key(a.position), kb = key(b.position);
+    return std::tie(ka.x, ka.y, a.slot) < std::tie(kb.x, kb.y, b.slot);
   });
+  const std::vector<Voter>& v = *voters;
   struct Column {
     uint32_t begin, end;
-    double low, high;  // of its voters' heights
+    double low, high;  // of its points' heights
   };
-  std::vector<Voter> voters(near.size());
   std::unordered_map<CellKey, Column, CellHash> columns;
-  for (size_t k = 0; k < keyed.size(); ++k) {
-    const CloudPoint& p = point(near[keyed[k].second].ref);
-    voters[k] = {p.position, keyed[k].second, FacesUpOrDown(p.normal)};
-    const double z = p.position.z();
-    auto [it, fresh] = columns.try_emplace(
-        keyed[k].first, Column{static_cast<uint32_t>(k), static_cast<uint32_t>(k + 1), z, z});
-    if (!fresh) {
-      it->second.end = static_cast<uint32_t>(k + 1);
-      it->second.low = std::min(it->second.low, z);
-      it->second.high = std::max(it->second.high, z);
+  for (size_t k = 0; k < v.size();) {
+    const CellKey at = key(v[k].position);
+    Column c{static_cast<uint32_t>(k), static_cast<uint32_t>(k), v[k].position.z(),
+             v[k].position.z()};
+    for (; k < v.size() && key(v[k].position) == at; ++k) {
+      c.low = std::min(c.low, v[k].position.z());
+      c.high = std::max(c.high, v[k].position.z());
     }
+    c.end = static_cast<uint32_t>(k);
+    columns.emplace(at, c);
   }
   // Where the 3 x 3 columns around one hold heights within `deep` of each
   // other, no median can lie further from any of them: most of the ground,
   // skipped without a look at each pair.
-  std::vector<std::pair<uint32_t, uint32_t>> unsettled;
+  std::vector<uint32_t> judged;
   for (const auto& [at, c] : columns) {
     double low = c.low, high = c.high;
     for (int64_t x = at.x - 1; x <= at.x + 1; ++x) {
@@ -269,12 +265,9 @@ void VoteNearBorders(const std::vector<NearBorder>& near, const PointOf& point, 
         high = std::max(high, it->second.high);
       }
     }
-    if (high - low > deep) unsettled.emplace_back(c.begin, c.end);
-  }
-  std::vector<uint32_t> judged;
-  for (const auto& [begin, end] : unsettled) {
-    for (uint32_t k = begin; k < end; ++k) {
-      if (near[voters[k].near].border < zone) judged.push_back(k);
+    if (high - low <= deep) continue;
+    for (uint32_t k = c.begin; k < c.end; ++k) {
+      if (v[k].border < zone) judged.push_back(k);
     }
   }
   std::sort(judged.begin(), judged.end());
@@ -284,20 +277,19 @@ void VoteNearBorders(const std::vector<NearBorder>& near, const PointOf& point, 
     std::vector<double> dz;
 #pragma omp for schedule(dynamic, 256)
     for (size_t i = 0; i < judged.size(); ++i) {
-      const uint32_t k = judged[i];
-      const Voter& v = voters[k];
-      const Eigen::Vector3d& p = v.position;
+      const Voter& judge = v[judged[i]];
+      const Eigen::Vector3d& p = judge.position;
       dz.clear();
       size_t steep = 0;
-      const CellKey at = keyed[k].first;
+      const CellKey at = key(p);
       for (int64_t x = at.x - 1; x <= at.x + 1; ++x) {
         for (int64_t y = at.y - 1; y <= at.y + 1; ++y) {
           const auto it = columns.find(CellKey{x, y, 0});
           if (it == columns.end()) continue;
           for (uint32_t j = it->second.begin; j < it->second.end; ++j) {
-            const Eigen::Vector3d d = voters[j].position - p;
+            const Eigen::Vector3d d = v[j].position - p;
             if (d.x() * d.x() + d.y() * d.y() > column2 || std::abs(d.z()) > reach) continue;
-            if (voters[j].up) {
+            if (v[j].up) {
               dz.push_back(d.z());
             } else {
               ++steep;
@@ -308,10 +300,10 @@ void VoteNearBorders(const std::vector<NearBorder>& near, const PointOf& point, 
       // Only the surfaces a vertical column cuts vote: a wall's points above
       // the ground at its foot would outvote it. A steep point is judged only
       // among them (a wrong match on open ground), not on a wall or a facade.
-      if (dz.empty() || (!v.up && steep * 3 > dz.size())) continue;
+      if (dz.empty() || (!judge.up && steep * 3 > dz.size())) continue;
       const auto mid = dz.begin() + static_cast<long>(dz.size() / 2);
       std::nth_element(dz.begin(), mid, dz.end());
-      (*drop)[near[v.near].slot] = std::abs(*mid) > deep;
+      (*drop)[judge.slot] = std::abs(*mid) > deep;
     }
   }
 }
@@ -401,7 +393,7 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
   // Kept points near a border, for the column vote.
   const double vote_zone = options.radius * options.vote_zone_radii;
   const double vote_column = options.radius * options.vote_column_radii;
-  std::vector<NearBorder> near;
+  std::vector<Voter> near;
   for (const Item& item : items) {
     if (item.contested) {
       const Eigen::Vector3d& p = point(item.ref).position;
@@ -427,15 +419,16 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
       kept_wide.Insert(p, item.ref);
     }
     if (vote_zone > 0 && item.border < vote_zone + vote_column) {
-      near.push_back({item.ref, order.size(), item.border});
+      const CloudPoint& p = point(item.ref);
+      near.push_back(
+          {p.position, static_cast<uint32_t>(order.size()), item.border, FacesUpOrDown(p.normal)});
     }
     order.push_back({item.ref.group, item.ref.index, item.core});
   }
   if (!near.empty()) {
     std::vector<uint8_t> drop(order.size(), 0);
-    VoteNearBorders(
-        near, [&](const Ref& r) -> const CloudPoint& { return point(r); }, vote_zone, vote_column,
-        deep, options.vote_reach_depths* deep, &drop);
+    VoteNearBorders(&near, vote_zone, vote_column, deep, options.vote_reach_depths * deep, &drop);
+    near = std::vector<Voter>();
     std::vector<MergedRef> dropped;
     size_t to = 0;
     for (size_t i = 0; i < order.size(); ++i) {
