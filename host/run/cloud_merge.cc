@@ -346,12 +346,13 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     bool contested;  // MayHaveForeignNeighbour
     bool blend;      // within options.blend_radii of its core's border
     float score;
-    float border;  // distance to its core's border (0 without a blend band)
+    float border;  // distance to its core's border (0 with no blend band or vote)
   };
   const double wide = options.radius * options.outside_core_radii;
   const double blend_width = options.radius * options.blend_radii;
+  const double border_reach = options.BorderReach();
   std::optional<CoreIndex> own_cores;
-  if (!cores) cores = &own_cores.emplace(centers, options.BorderReach());
+  if (!cores) cores = &own_cores.emplace(centers, border_reach);
   // A point outside its core is judged within `wide` of its normal line and
   // `deep` along it: the corners of that cylinder are `reach` away.
   const double deep = options.radius * options.surface_depth_radii;
@@ -367,10 +368,11 @@ std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
     // The core owner compares each point with every group's centre.
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < pts.size(); ++i) {
-      // The distance to the border only where a blend band asks for it.
+      // The distance to the border only where the blend band or the vote
+      // asks for it.
       const double x = pts[i].position.x(), y = pts[i].position.y();
-      const auto [owner, border] = options.BorderReach() > 0 ? cores->OwnerAndBorder({x, y})
-                                                             : std::pair{cores->Owner({x, y}), 0.0};
+      const auto [owner, border] =
+          border_reach > 0 ? cores->OwnerAndBorder({x, y}) : std::pair{cores->Owner({x, y}), 0.0};
       const bool core = owner == static_cast<int>(g);
       items[flat + i] = {
           {static_cast<int>(g), i}, core,         (core ? contested : contested_far)[flat + i] != 0,

@@ -102,7 +102,7 @@ struct MergeStats {
   long input = 0;
   long kept = 0;
   long duplicates = 0;              // dropped: another group's point within radius
-  long band_outliers = 0;           // dropped: off the surface a blend band agrees on
+  long band_outliers = 0;           // dropped: off their column's height by a border
   std::vector<long> kept_by_group;  // in the order of the groups given
   std::vector<long> core_by_group;  // of those, inside the group's own core
   // The tiled merge's seam levelling: borders measured, and the median
@@ -128,11 +128,11 @@ struct MergedRef {
 // What MergeGroupClouds keeps, in its output order (group, then index). A
 // group's cloud may hold only some of its points (a tile of the block, see
 // tiled_merge.h): every group's centre still takes part in the cores.
-// `cores`, the groups' centres indexed with options.radius * blend_radii as
-// their reach, saves a caller that merges many tiles building it for each
+// `cores`, the groups' centres indexed with options.BorderReach() as their
+// reach, saves a caller that merges many tiles building it for each
 // (CoreIndex); without, it is built from the groups' centres.
-// `band_outliers`, if given, receives the points the blend band's vote
-// dropped (MergeStats::band_outliers counts them).
+// `band_outliers`, if given, receives the points the vote by the borders
+// (vote_zone_radii) dropped (MergeStats::band_outliers counts them).
 std::vector<MergedRef> MergeGroupRefs(const std::vector<GroupCloud>& groups,
                                       const MergeOptions& options, MergeStats* stats = nullptr,
                                       const CoreIndex* cores = nullptr,
