@@ -109,6 +109,22 @@ TEST_F(FreeSpaceTest, AWeakerGroundPointDoesNotOutvoteABetterSupportedOne) {
   EXPECT_TRUE(VisibilityFilter(group, options, p.points, p.patches)[f]);
 }
 
+// The free-space test looks for the images that may see a point per box of
+// consecutive points: a box whose other points lie far outside image 3, or
+// behind every camera, must still have image 3 looked at.
+TEST_F(FreeSpaceTest, APointAmongFarOrUnseenPointsStillGoes) {
+  for (const Eigen::Vector3d& elsewhere :
+       {Eigen::Vector3d(-400, 0, 0), Eigen::Vector3d(0, 0, 300)}) {
+    Points p;
+    const int f = p.Add(floating, 0, {1, 2}, 0.9f);
+    p.Add(behind, 3, {4, 5, 6}, 0.95f);
+    for (int i = 0; i < 300; ++i) p.Add(elsewhere + Eigen::Vector3d(0, 0.1 * i, 0), 0, {1}, 0.9f);
+    ASSERT_FALSE(group.images[3].camera.InImage(group.images[3].camera.Project(elsewhere)) &&
+                 group.images[3].camera.Depth(elsewhere) > 0);
+    EXPECT_FALSE(VisibilityFilter(group, options, p.points, p.patches)[f]) << elsewhere.transpose();
+  }
+}
+
 // A steep plane, its normal 81 degrees from the nadir images' lines of sight
 // (Herz-Jesu-P8's ground from its cameras), sampled every 0.3 m across
 // (0.9 px): one 2 px cell of an image holds points 1.9 m apart in depth along
