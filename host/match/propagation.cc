@@ -590,6 +590,7 @@ void Propagator::Prune(const std::vector<bool>& keep) {
     }
   }
   front_.clear();
+  front_head_ = 0;
   if (grows_as_pmvs_) {
     // Every point's rim: an adaptive patch's centre lies among its own
     // points, whose cells it covers. A patch offers each cell beside its
@@ -619,24 +620,41 @@ void Propagator::Prune(const std::vector<bool>& keep) {
 
 std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wave) const {
   const int r = std::max(1, options_.window_size / 2);
+  // The centres' pixels on all cores; the greedy pass below is serial, as
+  // each candidate's turn depends on those kept before it.
+  std::vector<Eigen::Vector2f> uvs(wave->size());
+  ParallelFor(
+      static_cast<long>(wave->size()),
+      [&](long i) {
+        const PatchCandidate& c = (*wave)[i];
+        uvs[i] = group_.images[c.ref].camera.Project(c.center).cast<float>();
+      },
+      1024);
   // Kept centres by (image, block of r x r pixels): a clash lies in the
-  // candidate's block or one of the 8 around it.
-  std::unordered_map<uint64_t, std::vector<Eigen::Vector2f>> kept;
+  // candidate's block or one of the 8 around it. Each block's centres are a
+  // list through `next` (-1 ends it), in place of a vector per block, whose
+  // allocations were most of this pass.
+  std::unordered_map<uint64_t, int> block_head;
+  block_head.reserve(wave->size());
+  std::vector<int> next;
+  std::vector<Eigen::Vector2f> centres;
   auto key = [](int image, int bx, int by) {
     return static_cast<uint64_t>(image) << 42 ^ static_cast<uint64_t>(by + (1 << 20)) << 21 ^
            static_cast<uint64_t>(bx + (1 << 20));
   };
   std::vector<PatchCandidate> now, later;
-  for (PatchCandidate& c : *wave) {
-    const Eigen::Vector2f uv = group_.images[c.ref].camera.Project(c.center).cast<float>();
+  for (size_t i = 0; i < wave->size(); ++i) {
+    PatchCandidate& c = (*wave)[i];
+    const Eigen::Vector2f uv = uvs[i];
     const int bx = static_cast<int>(std::floor(uv.x() / r));
     const int by = static_cast<int>(std::floor(uv.y() / r));
     bool clash = false;
     for (int dy = -1; dy <= 1 && !clash; ++dy) {
       for (int dx = -1; dx <= 1 && !clash; ++dx) {
-        const auto found = kept.find(key(c.ref, bx + dx, by + dy));
-        if (found == kept.end()) continue;
-        for (const Eigen::Vector2f& o : found->second) {
+        const auto found = block_head.find(key(c.ref, bx + dx, by + dy));
+        if (found == block_head.end()) continue;
+        for (int k = found->second; k >= 0; k = next[k]) {
+          const Eigen::Vector2f& o = centres[k];
           if (std::abs(o.x() - uv.x()) < r && std::abs(o.y() - uv.y()) < r) {
             clash = true;
             break;
@@ -647,7 +665,12 @@ std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wav
     if (clash) {
       later.push_back(std::move(c));
     } else {
-      kept[key(c.ref, bx, by)].push_back(uv);
+      // Pushed at the list's head: the order within a block does not
+      // change whether one of them clashes.
+      const auto it = block_head.try_emplace(key(c.ref, bx, by), -1).first;
+      next.push_back(it->second);
+      centres.push_back(uv);
+      it->second = static_cast<int>(centres.size()) - 1;
       now.push_back(std::move(c));
     }
   }
@@ -657,31 +680,65 @@ std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wav
 
 void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) {
   const int cs = options_.cell_size;
-  while (!front_.empty() && (options_.max_waves == 0 || waves_ < options_.max_waves)) {
+  // The front's pending candidates are front_[front_head_, end): a wave
+  // taken from its head only moves the head. Erased from the vector, each
+  // wave moved all the rest (3 GB of candidates in Herz-Jesu-P8's pmvs pass).
+  while (front_.size() > front_head_ && (options_.max_waves == 0 || waves_ < options_.max_waves)) {
+    // Taken back once the spent head is as long as what is pending: each
+    // candidate is then moved a bounded number of times.
+    if (front_head_ >= front_.size() - front_head_) {
+      front_.erase(front_.begin(), front_.begin() + static_cast<std::ptrdiff_t>(front_head_));
+      front_head_ = 0;
+    }
     std::vector<PatchCandidate> wave;
-    if (static_cast<int>(front_.size()) <= options_.max_wave) {
-      wave.swap(front_);
+    const size_t max_wave = static_cast<size_t>(options_.max_wave);
+    if (front_.size() - front_head_ <= max_wave) {
+      if (front_head_ == 0) {
+        wave.swap(front_);
+      } else {
+        wave.assign(front_.begin() + static_cast<std::ptrdiff_t>(front_head_), front_.end());
+        front_.clear();
+      }
+      front_head_ = 0;
     } else {
       // Oldest first, so the front advances evenly.
-      wave.assign(front_.begin(), front_.begin() + options_.max_wave);
-      front_.erase(front_.begin(), front_.begin() + options_.max_wave);
+      const auto head = front_.begin() + static_cast<std::ptrdiff_t>(front_head_);
+      wave.assign(head, head + static_cast<std::ptrdiff_t>(max_wave));
+      front_head_ += max_wave;
     }
-    // Drop candidates whose cell was covered since they were queued.
-    wave.erase(std::remove_if(wave.begin(), wave.end(),
-                              [&](const PatchCandidate& c) {
-                                const Camera& cam = group_.images[c.ref].camera;
-                                const int cell = grids_[c.ref].Index(cam.Project(c.center), cs);
-                                return cell < 0 || grids_[c.ref].owner[cell] != -1;
-                              }),
-               wave.end());
+    // Drop candidates whose cell was covered since they were queued, their
+    // projections on all cores: the waves' own host work is serial, and the
+    // device waits for it.
+    std::vector<uint8_t> covered(wave.size());
+    ParallelFor(
+        static_cast<long>(wave.size()),
+        [&](long i) {
+          const PatchCandidate& c = wave[i];
+          const int cell = grids_[c.ref].Index(group_.images[c.ref].camera.Project(c.center), cs);
+          covered[i] = cell < 0 || grids_[c.ref].owner[cell] != -1;
+        },
+        1024);
+    size_t open = 0;
+    for (size_t i = 0; i < wave.size(); ++i) {
+      if (!covered[i]) wave[open++] = std::move(wave[i]);
+    }
+    wave.resize(open);
     if (wave.empty()) continue;
     std::stable_sort(wave.begin(), wave.end(),
                      [](const PatchCandidate& a, const PatchCandidate& b) {
                        return a.parent_score > b.parent_score;
                      });
+    // The crowded ones go back ahead of everything pending, in the head's
+    // spent room when it holds them.
     std::vector<PatchCandidate> later = Crowded(&wave);
-    front_.insert(front_.begin(), std::make_move_iterator(later.begin()),
-                  std::make_move_iterator(later.end()));
+    if (later.size() <= front_head_) {
+      front_head_ -= later.size();
+      std::move(later.begin(), later.end(),
+                front_.begin() + static_cast<std::ptrdiff_t>(front_head_));
+    } else {
+      front_.insert(front_.begin() + static_cast<std::ptrdiff_t>(front_head_),
+                    std::make_move_iterator(later.begin()), std::make_move_iterator(later.end()));
+    }
     ++waves_;
     candidates_ += static_cast<long>(wave.size());
     largest_wave_ = std::max(largest_wave_, static_cast<long>(wave.size()));
@@ -692,7 +749,10 @@ void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) 
     if (on_wave) on_wave(waves_, static_cast<long>(wave.size()), static_cast<long>(points_.size()));
   }
   // The front's largest size stays allocated otherwise, through the filter.
-  if (front_.empty()) std::vector<PatchCandidate>().swap(front_);
+  if (front_.size() == front_head_) {
+    std::vector<PatchCandidate>().swap(front_);
+    front_head_ = 0;
+  }
 }
 
 }  // namespace sapmvs

@@ -192,6 +192,7 @@ class Propagator {
   std::vector<std::vector<int>> covers_;  // per patch, EmitPlan::covers
   std::vector<DensePoint> points_;
   std::vector<PatchCandidate> front_;
+  size_t front_head_ = 0;  // front_[0, front_head_) is spent (RunWaves)
   // cut_[p]: RefitPlanes cut patch p back to its centre (with refill_cut it
   // expands from there); one per patch, pushed with it.
   std::vector<uint8_t> cut_;
