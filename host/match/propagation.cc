@@ -618,18 +618,9 @@ void Propagator::Prune(const std::vector<bool>& keep) {
   }
 }
 
-std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wave) const {
+std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wave,
+                                                const std::vector<Eigen::Vector2d>& pixels) const {
   const int r = std::max(1, options_.window_size / 2);
-  // The centres' pixels on all cores; the greedy pass below is serial, as
-  // each candidate's turn depends on those kept before it.
-  std::vector<Eigen::Vector2f> uvs(wave->size());
-  ParallelFor(
-      static_cast<long>(wave->size()),
-      [&](long i) {
-        const PatchCandidate& c = (*wave)[i];
-        uvs[i] = group_.images[c.ref].camera.Project(c.center).cast<float>();
-      },
-      1024);
   // Kept centres by (image, block of r x r pixels): a clash lies in the
   // candidate's block or one of the 8 around it. Each block's centres are a
   // list through `next` (-1 ends it), in place of a vector per block, whose
@@ -645,7 +636,7 @@ std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wav
   std::vector<PatchCandidate> now, later;
   for (size_t i = 0; i < wave->size(); ++i) {
     PatchCandidate& c = (*wave)[i];
-    const Eigen::Vector2f uv = uvs[i];
+    const Eigen::Vector2f uv = pixels[i].cast<float>();
     const int bx = static_cast<int>(std::floor(uv.x() / r));
     const int by = static_cast<int>(std::floor(uv.y() / r));
     bool clash = false;
@@ -708,29 +699,40 @@ void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) 
     }
     // Drop candidates whose cell was covered since they were queued, their
     // projections on all cores: the waves' own host work is serial, and the
-    // device waits for it.
+    // device waits for it. Each centre's pixel is kept for Crowded.
+    std::vector<Eigen::Vector2d> pixel(wave.size());
     std::vector<uint8_t> covered(wave.size());
     ParallelFor(
         static_cast<long>(wave.size()),
         [&](long i) {
           const PatchCandidate& c = wave[i];
-          const int cell = grids_[c.ref].Index(group_.images[c.ref].camera.Project(c.center), cs);
+          pixel[i] = group_.images[c.ref].camera.Project(c.center);
+          const int cell = grids_[c.ref].Index(pixel[i], cs);
           covered[i] = cell < 0 || grids_[c.ref].owner[cell] != -1;
         },
         1024);
-    size_t open = 0;
+    std::vector<size_t> open;
     for (size_t i = 0; i < wave.size(); ++i) {
-      if (!covered[i]) wave[open++] = std::move(wave[i]);
+      if (!covered[i]) open.push_back(i);
     }
-    wave.resize(open);
-    if (wave.empty()) continue;
-    std::stable_sort(wave.begin(), wave.end(),
-                     [](const PatchCandidate& a, const PatchCandidate& b) {
-                       return a.parent_score > b.parent_score;
-                     });
+    if (open.empty()) continue;
+    // Best parent first; the candidates and their pixels gathered in that
+    // order.
+    std::stable_sort(open.begin(), open.end(), [&](size_t a, size_t b) {
+      return wave[a].parent_score > wave[b].parent_score;
+    });
+    std::vector<PatchCandidate> sorted;
+    std::vector<Eigen::Vector2d> sorted_pixel;
+    sorted.reserve(open.size());
+    sorted_pixel.reserve(open.size());
+    for (const size_t i : open) {
+      sorted.push_back(std::move(wave[i]));
+      sorted_pixel.push_back(pixel[i]);
+    }
+    wave.swap(sorted);
     // The crowded ones go back ahead of everything pending, in the head's
     // spent room when it holds them.
-    std::vector<PatchCandidate> later = Crowded(&wave);
+    std::vector<PatchCandidate> later = Crowded(&wave, sorted_pixel);
     if (later.size() <= front_head_) {
       front_head_ -= later.size();
       std::move(later.begin(), later.end(),

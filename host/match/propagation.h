@@ -172,8 +172,10 @@ class Propagator {
   }
   // Moves out of `wave` (in order) the candidates whose centre lies within
   // window_size / 2 pixels, on both axes, of an earlier kept one's in the
-  // same reference image, and returns them in order.
-  std::vector<PatchCandidate> Crowded(std::vector<PatchCandidate>* wave) const;
+  // same reference image, and returns them in order. `pixels[i]`: wave[i]'s
+  // centre projected in its reference image.
+  std::vector<PatchCandidate> Crowded(std::vector<PatchCandidate>* wave,
+                                      const std::vector<Eigen::Vector2d>& pixels) const;
   // Accepts the evaluated candidates best score first; returns accepted indices.
   std::vector<int> AcceptBatch(std::vector<std::optional<AcceptedPatch>>& results);
 
