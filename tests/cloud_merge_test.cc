@@ -429,34 +429,27 @@ TEST(CloudMerge, BadRadiusIsAnError) {
   PointCloud a;
   std::vector<GroupCloud> groups = {{&a, {0, 0}}};
   MergeOptions o;
-  for (const double r : {0.0, -1.0, std::nan("")}) {
-    o.radius = r;
-    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << r;
+  // Each field in turn: its bad values throw, then a good one is set.
+  struct Case {
+    double MergeOptions::*field;
+    std::vector<double> bad;
+    double good;
+  };
+  const std::vector<Case> cases = {
+      {&MergeOptions::radius, {0.0, -1.0, std::nan("")}, 1},
+      {&MergeOptions::outside_core_radii, {0.99, std::nan("")}, 1},
+      {&MergeOptions::blend_radii, {-0.5, std::nan("")}, 0},
+      {&MergeOptions::vote_zone_radii, {-1.0, std::nan("")}, 40},
+      {&MergeOptions::vote_column_radii, {0.0, std::nan("")}, 6},
+      {&MergeOptions::vote_reach_depths, {0.5}, 6},
+  };
+  for (const Case& c : cases) {
+    for (const double bad : c.bad) {
+      o.*c.field = bad;
+      EXPECT_THROW(MergeGroupClouds(groups, o), Error) << bad;
+    }
+    o.*c.field = c.good;
   }
-  o.radius = 1;
-  for (const double k : {0.99, std::nan("")}) {
-    o.outside_core_radii = k;
-    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
-  }
-  o.outside_core_radii = 1;
-  for (const double k : {-0.5, std::nan("")}) {
-    o.blend_radii = k;
-    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
-  }
-  o.blend_radii = 0;
-  for (const double k : {-1.0, std::nan("")}) {
-    o.vote_zone_radii = k;
-    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
-  }
-  o.vote_zone_radii = 40;
-  for (const double k : {0.0, std::nan("")}) {
-    o.vote_column_radii = k;
-    EXPECT_THROW(MergeGroupClouds(groups, o), Error) << k;
-  }
-  o.vote_column_radii = 6;
-  o.vote_reach_depths = 0.5;
-  EXPECT_THROW(MergeGroupClouds(groups, o), Error);
-  o.vote_reach_depths = 6;
   EXPECT_NO_THROW(MergeGroupClouds(groups, o));
 }
 
