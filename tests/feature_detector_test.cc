@@ -198,6 +198,33 @@ TEST(DetectFeatures, KeepsTheStrongestOfEachBlock) {
   }
 }
 
+// Each (detector, block)'s features are ranked 0, 1, ... from the strongest:
+// the first few of each block seed first (first_features_per_block).
+TEST(DetectFeatures, RanksEachBlocksFeaturesFromTheStrongest) {
+  const std::vector<Feature> kept = DetectFeatures(Checkerboard(6), 3, 2);
+  std::map<std::tuple<int, int, int>, std::vector<const Feature*>> by_block;
+  for (const Feature& f : kept) {
+    by_block[{static_cast<int>(f.kind), static_cast<int>(f.uv.x()) / kFeatureBlock,
+              static_cast<int>(f.uv.y()) / kFeatureBlock}]
+        .push_back(&f);
+  }
+  ASSERT_GE(by_block.size(), 12u);  // both detectors over 4 x 3 blocks
+  for (const auto& [key, block] : by_block) {
+    std::vector<int> ranks;
+    for (const Feature* f : block) ranks.push_back(f->block_rank);
+    std::sort(ranks.begin(), ranks.end());
+    for (size_t r = 0; r < ranks.size(); ++r) EXPECT_EQ(ranks[r], static_cast<int>(r));
+    for (const Feature* a : block) {
+      for (const Feature* b : block) {
+        if (a->block_rank < b->block_rank) {
+          EXPECT_GE(a->strength, b->strength)
+              << "(" << a->uv.transpose() << ") ranked before (" << b->uv.transpose() << ")";
+        }
+      }
+    }
+  }
+}
+
 TEST(DetectFeatures, MarginIsRespected) {
   const cv::Mat grey = Checkerboard(6);
   constexpr int kMargin = 7;

@@ -98,6 +98,8 @@ TEST(MatcherOptions, BadValuesFailCheckNamingTheValue) {
        "view_angle_deg"},
       {"features_per_block 0", [](MatcherOptions& o) { o.features_per_block = 0; },
        "features_per_block"},
+      {"first_features_per_block -1", [](MatcherOptions& o) { o.first_features_per_block = -1; },
+       "first_features_per_block"},
       {"epipolar_distance 0", [](MatcherOptions& o) { o.epipolar_distance = 0; },
        "epipolar_distance"},
       {"max_wave 0", [](MatcherOptions& o) { o.max_wave = 0; }, "max_wave"},
@@ -460,6 +462,28 @@ TEST_F(MatchGroupTest, LaterPassesGrowIntoTheCellsTheFilterFreed) {
   int propagation = 0;
   for (const auto& [name, t] : three.result.stats.stages) propagation += name == "propagation";
   EXPECT_EQ(propagation, 1);
+}
+
+// Seeding in two tiers: the first features of each block seed the first
+// waves, the rest only the cells those left empty. Fewer seeds are tried
+// than when all seed at once, more than with the first tier alone, for the
+// same surface.
+TEST_F(MatchGroupTest, LateSeedsTryOnlyWhatTheFirstWavesLeftEmpty) {
+  MatcherOptions o = Options(MatchMode::kSapmvs);
+  ASSERT_GT(o.first_features_per_block, 0);
+  ASSERT_LT(o.first_features_per_block, o.features_per_block);
+  const Measured tiers = MatchAndCheck(o);
+  o.first_features_per_block = 0;
+  const Measured at_once = MatchAndCheck(o);
+  o.features_per_block = MatcherOptions{}.first_features_per_block;
+  const Measured first_only = MatchAndCheck(o);
+  std::printf("[ measured ] seeds tried: %ld in two tiers, %ld at once, %ld first tier only\n",
+              tiers.result.stats.seeds_tried, at_once.result.stats.seeds_tried,
+              first_only.result.stats.seeds_tried);
+  EXPECT_LT(tiers.result.stats.seeds_tried, 0.9 * at_once.result.stats.seeds_tried);
+  EXPECT_GT(tiers.result.stats.seeds_tried, first_only.result.stats.seeds_tried);
+  EXPECT_GT(tiers.check.cells_covered, 0.98 * at_once.check.cells_covered);
+  EXPECT_GT(tiers.check.share_within, at_once.check.share_within - 0.01);
 }
 
 // The last pass growing one-cell patches as PMVS does, in place of a third

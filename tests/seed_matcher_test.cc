@@ -218,6 +218,63 @@ TEST(SeedMatcherTest, FindsExactlyTheCandidatesOfAFullScan) {
   EXPECT_GT(candidates, 2 * static_cast<long>(features[0].size()));
 }
 
+// Seeds for some reference features only (the later features of each block,
+// matched once the first waves have run): exactly those features' seeds of
+// a call for all, since every feature of the views stays a partner, their
+// support included.
+TEST(SeedMatcherTest, WantedFeaturesGetTheSeedsOfACallForAll) {
+  const test::PlaneScene scene = test::MakePlaneScene(3, 241, 181, 23);
+  MatchGroupData group;
+  for (int i = 0; i < 3; ++i) {
+    MatchImage image;
+    image.camera = scene.cameras[i];
+    for (int j = 0; j < 3; ++j) {
+      if (j != i) image.views.push_back(j);
+    }
+    image.depth = image.camera.Depth(test::GroundAt(image.camera, Eigen::Vector2d(120, 90)));
+    group.images.push_back(image);
+  }
+  MatcherOptions options;
+  std::mt19937 rng(23);
+  std::vector<std::vector<Feature>> features(3);
+  for (auto& f : features) AddRandomFeatures(rng, 300, &f);
+  // Each feature's match in the other images, so that seeds have partners
+  // and support.
+  for (size_t k = 0; k < 300; ++k) {
+    const Eigen::Vector3d ground = test::GroundAt(group.images[0].camera, features[0][k].uv);
+    for (int j = 1; j < 3; ++j) {
+      Feature g = features[0][k];
+      g.uv = group.images[j].camera.Project(ground);
+      features[j].push_back(g);
+    }
+  }
+  for (auto& image : features) {
+    for (size_t k = 0; k < image.size(); ++k) image[k].block_rank = static_cast<int>(k % 3);
+  }
+  auto wanted = [](int image, const Feature& f) { return image != 1 && f.block_rank == 2; };
+  const std::vector<SeedFeature> all = MatchSeeds(group, features, options);
+  const std::vector<SeedFeature> some = MatchSeeds(group, features, options, wanted);
+  std::vector<const SeedFeature*> expected;
+  for (const SeedFeature& s : all) {
+    const auto f = std::find_if(features[s.image].begin(), features[s.image].end(),
+                                [&](const Feature& g) { return g.uv == s.uv; });
+    ASSERT_NE(f, features[s.image].end());
+    if (wanted(s.image, *f)) expected.push_back(&s);
+  }
+  ASSERT_GT(expected.size(), 50u);
+  ASSERT_LT(expected.size(), all.size() / 2);
+  ASSERT_EQ(some.size(), expected.size());
+  for (size_t i = 0; i < some.size(); ++i) {
+    EXPECT_EQ(some[i].image, expected[i]->image);
+    EXPECT_EQ(some[i].uv, expected[i]->uv);
+    ASSERT_EQ(some[i].candidates.size(), expected[i]->candidates.size()) << "seed " << i;
+    for (size_t c = 0; c < some[i].candidates.size(); ++c) {
+      EXPECT_EQ(some[i].candidates[c].center, expected[i]->candidates[c].center)
+          << "seed " << i << ", candidate " << c;
+    }
+  }
+}
+
 // The candidates are ranked by support (the other views with a feature of
 // the same kind within epipolar_distance of the candidate's projection),
 // then by distance from the epipolar line, then in the order the partners

@@ -45,6 +45,7 @@ void KeepBlockMaxima(const cv::Mat& response, FeatureKind kind, int per_block, i
       const size_t keep = std::min(block.size(), static_cast<size_t>(per_block));
       std::partial_sort(block.begin(), block.begin() + keep, block.end(),
                         [](const Feature& a, const Feature& b) { return a.strength > b.strength; });
+      for (size_t k = 0; k < keep; ++k) block[k].block_rank = static_cast<int>(k);
       out->insert(out->end(), block.begin(), block.begin() + keep);
     }
   }

@@ -14,6 +14,7 @@ struct Feature {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // pixel, (0,0) = centre of the top-left pixel
   FeatureKind kind = FeatureKind::kHarris;
   float strength = 0;  // detector response (|DoG| or Harris), for ranking within a block
+  int block_rank = 0;  // 0 = the strongest of its detector in its block
 };
 
 // Side of the blocks features are spread over, pixels (PMVS's 32).

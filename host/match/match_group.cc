@@ -177,7 +177,15 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   end_stage("features");
 
   report("seeds", 0, 0, "epipolar candidates");
-  std::vector<SeedFeature> seeds = MatchSeeds(group, features, options);
+  // The features after the first first_features_per_block of each block
+  // seed only the cells the first pass's waves leave empty.
+  const bool late_seeds = options.mode == MatchMode::kSapmvs &&
+                          options.first_features_per_block > 0 &&
+                          options.first_features_per_block < options.features_per_block &&
+                          options.pmvs_passes < options.expand_iterations;
+  std::vector<SeedFeature> seeds = MatchSeeds(group, features, options, [&](int, const Feature& f) {
+    return !late_seeds || f.block_rank < options.first_features_per_block;
+  });
   report("seeds", 0, 0, "building kernels");
   prepare.thread.join();
   PatchEngine engine(kernels, group, options);
@@ -190,9 +198,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
   // Their candidates (14 MB on `city`) would otherwise stay through the
   // filter, where a group's run peaks.
   std::vector<SeedFeature>().swap(seeds);
-  std::vector<std::vector<Feature>>().swap(features);
-  stats.seeds_tried = propagator.seeds_tried();
-  stats.seeds_accepted = propagator.seeds_accepted();
+  if (!late_seeds) std::vector<std::vector<Feature>>().swap(features);
   end_stage("seeds");
 
   // Per image, the depths its accepted seeds span (5th to 95th percentile),
@@ -258,6 +264,18 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
       };
     };
     propagator.RunWaves(on_wave(as_pmvs ? "pmvs wave" : "wave"));
+    if (late_seeds && pass == 0) {
+      report("propagation", 1, options.expand_iterations, "late seeds");
+      std::vector<SeedFeature> late =
+          MatchSeeds(group, features, options, [&](int image, const Feature& f) {
+            return f.block_rank >= options.first_features_per_block &&
+                   propagator.CellFree(image, f.uv);
+          });
+      std::vector<std::vector<Feature>>().swap(features);
+      propagator.RunSeeds(late);
+      std::vector<SeedFeature>().swap(late);
+      propagator.RunWaves(on_wave("wave"));
+    }
     // One-cell patches emit their centres only: nothing to refit.
     if (!as_pmvs) {
       const long cut = propagator.RefitPlanes();
@@ -294,6 +312,8 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     stats.removed_clusters += removed.removed_clusters;
     end_stage("filter");
   }
+  stats.seeds_tried = propagator.seeds_tried();
+  stats.seeds_accepted = propagator.seeds_accepted();
   stats.candidates = propagator.candidates();
   stats.waves = propagator.waves();
   stats.largest_wave = propagator.largest_wave();

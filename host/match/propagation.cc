@@ -414,6 +414,7 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
                           const std::function<void(long, long, long)>& on_rank) {
   std::vector<uint8_t> done(seeds.size(), 0);
   const int cs = options_.cell_size;
+  const size_t first_patch = patches_.size();
   for (int rank = 0; rank < options_.candidates_per_feature; ++rank) {
     std::vector<PatchCandidate> batch;
     std::vector<int> which;
@@ -438,11 +439,16 @@ void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
     }
     if (on_rank) on_rank(rank + 1, options_.candidates_per_feature, seeds_accepted_);
   }
-  for (size_t p = 0; p < patches_.size(); ++p) {
+  for (size_t p = first_patch; p < patches_.size(); ++p) {
     const Camera& cam = group_.images[patches_[p].ref].camera;
     seed_depths_[patches_[p].ref].push_back(cam.Depth(patches_[p].center));
     Expand(static_cast<int>(p), &front_);
   }
+}
+
+bool Propagator::CellFree(int image, const Eigen::Vector2d& uv) const {
+  const int cell = grids_[image].Index(uv, options_.cell_size);
+  return cell >= 0 && grids_[image].owner[cell] == -1;
 }
 
 void Propagator::Release(const DensePoint& d) {

@@ -48,10 +48,13 @@ class Propagator {
   Propagator(const MatchGroupData& group, const MatcherOptions& options, PatchEngine& engine);
 
   // Tries each feature's candidates in order, one batch per rank, keeping
-  // the first accepted; accepted seeds start the front.
+  // the first accepted; accepted seeds join the front. May follow waves:
+  // a seed whose cell a patch holds by then is not tried.
   // `on_rank(rank, ranks, accepted)` after each rank of candidates is scored.
   void RunSeeds(const std::vector<SeedFeature>& seeds,
                 const std::function<void(long, long, long)>& on_rank = {});
+  // True when the cell of pixel uv of `image` is inside it and empty.
+  bool CellFree(int image, const Eigen::Vector2d& uv) const;
   // The ground the group owns: no seed or candidate whose centre lies
   // outside it is tried, so no patch grows there. Everything by default.
   void SetRegion(const GroundRegion& region) { region_ = region; }

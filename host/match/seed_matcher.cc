@@ -196,7 +196,8 @@ Eigen::Vector3d TriangulateMidpoint(const Camera& a, const Eigen::Vector2d& uv_a
 
 std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
                                     const std::vector<std::vector<Feature>>& features,
-                                    const MatcherOptions& options) {
+                                    const MatcherOptions& options,
+                                    const std::function<bool(int, const Feature&)>& wanted) {
   const int n = static_cast<int>(group.images.size());
   std::vector<FeatureIndex> index;
   index.reserve(n);
@@ -209,7 +210,9 @@ std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
   std::vector<std::pair<int, int>> work;  // (image, feature), in seed order
   for (int i = 0; i < n; ++i) {
     if (!group.images[i].reference) continue;  // its features are partners only
-    for (size_t fi = 0; fi < features[i].size(); ++fi) work.emplace_back(i, static_cast<int>(fi));
+    for (size_t fi = 0; fi < features[i].size(); ++fi) {
+      if (!wanted || wanted(i, features[i][fi])) work.emplace_back(i, static_cast<int>(fi));
+    }
   }
   std::vector<SeedFeature> local(work.size());
 #pragma omp parallel for schedule(dynamic, 64)

@@ -5,6 +5,7 @@
 // depth consistency: how many further views hold a same-kind feature within
 // that distance of the point's projection, then by epipolar distance.
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "match/feature_detector.h"
@@ -25,9 +26,12 @@ struct SeedFeature {
 inline constexpr double kSeedDepthMin = 0.5;
 inline constexpr double kSeedDepthMax = 2.0;
 
+// The seeds of the reference features `wanted` says (image, feature) are
+// (all when empty); every feature of the views stays a partner.
 std::vector<SeedFeature> MatchSeeds(const MatchGroupData& group,
                                     const std::vector<std::vector<Feature>>& features,
-                                    const MatcherOptions& options);
+                                    const MatcherOptions& options,
+                                    const std::function<bool(int, const Feature&)>& wanted = {});
 
 // Midpoint of the shortest segment between the rays through uv_a in camera a
 // and uv_b in camera b; NaN when the rays are parallel.
