@@ -413,15 +413,13 @@ std::vector<int> Propagator::AcceptBatch(std::vector<std::optional<AcceptedPatch
 void Propagator::RunSeeds(const std::vector<SeedFeature>& seeds,
                           const std::function<void(long, long, long)>& on_rank) {
   std::vector<uint8_t> done(seeds.size(), 0);
-  const int cs = options_.cell_size;
   const size_t first_patch = patches_.size();
   for (int rank = 0; rank < options_.candidates_per_feature; ++rank) {
     std::vector<PatchCandidate> batch;
     std::vector<int> which;
     for (size_t s = 0; s < seeds.size(); ++s) {
       if (done[s] || rank >= static_cast<int>(seeds[s].candidates.size())) continue;
-      const int cell = grids_[seeds[s].image].Index(seeds[s].uv, cs);
-      if (cell < 0 || grids_[seeds[s].image].owner[cell] != -1) continue;
+      if (!CellFree(seeds[s].image, seeds[s].uv)) continue;
       if (!InRegion(seeds[s].candidates[rank].center)) continue;
       batch.push_back(seeds[s].candidates[rank]);
       which.push_back(static_cast<int>(s));
@@ -676,7 +674,6 @@ std::vector<PatchCandidate> Propagator::Crowded(std::vector<PatchCandidate>* wav
 }
 
 void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) {
-  const int cs = options_.cell_size;
   // The front's pending candidates are front_[front_head_, end): a wave
   // taken from its head only moves the head. Erased from the vector, each
   // wave moved all the rest (3 GB of candidates in Herz-Jesu-P8's pmvs pass).
@@ -713,8 +710,7 @@ void Propagator::RunWaves(const std::function<void(long, long, long)>& on_wave) 
         [&](long i) {
           const PatchCandidate& c = wave[i];
           pixel[i] = group_.images[c.ref].camera.Project(c.center);
-          const int cell = grids_[c.ref].Index(pixel[i], cs);
-          covered[i] = cell < 0 || grids_[c.ref].owner[cell] != -1;
+          covered[i] = !CellFree(c.ref, pixel[i]);
         },
         1024);
     std::vector<size_t> open;

@@ -53,7 +53,8 @@ class Propagator {
   // `on_rank(rank, ranks, accepted)` after each rank of candidates is scored.
   void RunSeeds(const std::vector<SeedFeature>& seeds,
                 const std::function<void(long, long, long)>& on_rank = {});
-  // True when the cell of pixel uv of `image` is inside it and empty.
+  // True when the cell of pixel uv of `image` is inside it and empty: where
+  // a seed or a wave's candidate is still worth trying.
   bool CellFree(int image, const Eigen::Vector2d& uv) const;
   // The ground the group owns: no seed or candidate whose centre lies
   // outside it is tried, so no patch grows there. Everything by default.
