@@ -100,6 +100,8 @@ TEST(MatcherOptions, BadValuesFailCheckNamingTheValue) {
        "features_per_block"},
       {"first_features_per_block -1", [](MatcherOptions& o) { o.first_features_per_block = -1; },
        "first_features_per_block"},
+      {"visibility_only_filters 10", [](MatcherOptions& o) { o.visibility_only_filters = 10; },
+       "visibility_only_filters"},
       {"epipolar_distance 0", [](MatcherOptions& o) { o.epipolar_distance = 0; },
        "epipolar_distance"},
       {"max_wave 0", [](MatcherOptions& o) { o.max_wave = 0; }, "max_wave"},
@@ -484,6 +486,28 @@ TEST_F(MatchGroupTest, LateSeedsTryOnlyWhatTheFirstWavesLeftEmpty) {
   EXPECT_GT(tiers.result.stats.seeds_tried, first_only.result.stats.seeds_tried);
   EXPECT_GT(tiers.check.cells_covered, 0.98 * at_once.check.cells_covered);
   EXPECT_GT(tiers.check.share_within, at_once.check.share_within - 0.01);
+}
+
+// The first pass's filter testing scores and visibility only: its
+// neighbourhood failures go at the second pass's filter, for the same
+// surface. The last pass's filter tests all whatever the option says.
+TEST_F(MatchGroupTest, AnEarlyFilterOfScoresAndVisibilityKeepsTheSurface) {
+  MatcherOptions o = Options(MatchMode::kSapmvs);
+  ASSERT_EQ(o.visibility_only_filters, 1);
+  ASSERT_GE(o.expand_iterations, 2);
+  const Measured light = MatchAndCheck(o);
+  o.visibility_only_filters = 0;
+  const Measured full = MatchAndCheck(o);
+  o.visibility_only_filters = 9;
+  const Measured all_light = MatchAndCheck(o);
+  std::printf("[ measured ] cells covered %ld light first, %ld full; within 2 GSD %.4f, %.4f\n",
+              light.check.cells_covered, full.check.cells_covered, light.check.share_within,
+              full.check.share_within);
+  EXPECT_NE(light.result.stats.points_before_filter, full.result.stats.points_before_filter);
+  EXPECT_GT(light.check.cells_covered, 0.98 * full.check.cells_covered);
+  EXPECT_GT(light.check.share_within, full.check.share_within - 0.01);
+  EXPECT_GT(all_light.result.stats.removed_neighbourhood, 0);
+  EXPECT_GT(all_light.check.share_within, full.check.share_within - 0.03);
 }
 
 // The last pass growing one-cell patches as PMVS does, in place of a third

@@ -243,6 +243,46 @@ TEST(FilterPoints, OneCellPatchesPlanesAreNotJudgedByTheirNeighbours) {
   EXPECT_EQ(one_cell_stats.removed_neighbourhood, 0);
 }
 
+// An early pass's filter (MatcherOptions::visibility_only_filters): the
+// score floor and the visibility test decide alone, so the tilted patches
+// that the patch-support test drops above stay, and the weak ones go.
+TEST(FilterPoints, ScoreAndVisibilityAloneLeaveTheNeighbourhoodTests) {
+  const MatchGroupData group = NadirGroup({{-10, 0, 100}, {0, 0, 100}, {10, 0, 100}});
+  MatcherOptions options;
+  int weak = 0;
+  Points p = GridWithWeakPatches(&weak);
+  const int first_tilted = static_cast<int>(p.patches.size());
+  for (int i = 0; i < 10; ++i) {
+    const int k = p.Add(Eigen::Vector3d(-4.35 + 0.9 * i, 0.15, 0), 0, {1, 2}, 0.97f);
+    const double t = std::sin(M_PI / 3) / std::sqrt(2.0);
+    p.patches[p.points[k].patch].normal = Eigen::Vector3d(t, t, std::cos(M_PI / 3));
+  }
+  const PatchClasses floor(0.9);
+  MatchStats all_stats, light_stats;
+  const std::vector<bool> all =
+      FilterPoints(group, options, p.points, p.patches, &all_stats, floor, FilterTests::kAll);
+  const std::vector<bool> light = FilterPoints(group, options, p.points, p.patches, &light_stats,
+                                               floor, FilterTests::kScoreAndVisibility);
+  std::vector<bool> eligible(p.points.size());
+  for (size_t i = 0; i < p.points.size(); ++i)
+    eligible[i] = p.patches[p.points[i].patch].score >= 0.9f;
+  const std::vector<bool> visible = VisibilityFilter(group, options, p.points, p.patches, eligible);
+  long tilted_kept = 0;
+  for (size_t i = 0; i < p.points.size(); ++i) {
+    EXPECT_EQ(light[i], visible[i]) << i;
+    if (all[i]) {
+      EXPECT_TRUE(light[i]) << i;
+    }
+    tilted_kept += light[i] && p.points[i].patch >= first_tilted;
+  }
+  EXPECT_EQ(tilted_kept, 10);
+  EXPECT_EQ(light_stats.removed_score, weak);
+  EXPECT_EQ(all_stats.removed_score, weak);
+  EXPECT_GT(all_stats.removed_neighbourhood, 0);
+  EXPECT_EQ(light_stats.removed_neighbourhood, 0);
+  EXPECT_EQ(light_stats.removed_clusters, 0);
+}
+
 // A pixel of disparity in a view 60 m off a nadir reference at 100 m (31
 // degrees between the rays) moves a ground point 1.94 footprints in depth,
 // in one 10 m off (5.7 degrees) 10.0 footprints.

@@ -303,7 +303,11 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     // holes: on `city` 10-12 MiB of that peak, handed back here.
     ReleaseFreeMemory();
     MatchStats removed;
-    keep = FilterPoints(group, options, points, patches, &removed, classes);
+    const bool light =
+        options.mode == MatchMode::kSapmvs &&
+        pass < std::min(options.visibility_only_filters, options.expand_iterations - 1);
+    keep = FilterPoints(group, options, points, patches, &removed, classes,
+                        light ? FilterTests::kScoreAndVisibility : FilterTests::kAll);
     stats.removed_depth_range += ApplyDepthFences(group, points, patches, plausible, &keep);
     stats.removed_score += removed.removed_score;
     stats.plane_tolerance = removed.plane_tolerance;

@@ -319,7 +319,7 @@ double DisparityDepth(const MatchGroupData& group, const AcceptedPatch& patch) {
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
-                               const PatchClasses& classes) {
+                               const PatchClasses& classes, FilterTests tests) {
   std::vector<bool> eligible(points.size());
   long low = 0;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -334,7 +334,7 @@ std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions
     if (keep[i]) alive.push_back(static_cast<int>(i));
   }
   stats->removed_visibility = static_cast<long>(points.size() - alive.size()) - low;
-  if (alive.empty()) return keep;
+  if (alive.empty() || tests == FilterTests::kScoreAndVisibility) return keep;
 
   // nn[a * k + j]: the row of the j-th nearest neighbour of row a's point
   // (alive[a]) within a's radius, neighbour_radius footprints along its

@@ -56,13 +56,20 @@ struct PatchClasses {
 // the sine of the angle between the two rays (infinity without views).
 double DisparityDepth(const MatchGroupData& group, const AcceptedPatch& patch);
 
+// Which of FilterPoints' tests run: all, or the score floor and the
+// visibility test alone (MatcherOptions::visibility_only_filters), which
+// leave the neighbourhood, plane-support and cluster tests, and the
+// neighbour table that is most of the filter's time, to a later pass.
+enum class FilterTests { kAll, kScoreAndVisibility };
 // keep[i] for points[i]; stats' removed_* counters and plane_tolerance are
-// filled. Points of patches scoring below their floor (`classes`) go first
-// (removed_score) and take no part in the other passes.
+// filled (plane_tolerance by kAll only). Points of patches scoring below
+// their floor (`classes`) go first (removed_score) and take no part in the
+// other passes.
 std::vector<bool> FilterPoints(const MatchGroupData& group, const MatcherOptions& options,
                                const std::vector<DensePoint>& points,
                                const std::vector<AcceptedPatch>& patches, MatchStats* stats,
-                               const PatchClasses& classes = PatchClasses());
+                               const PatchClasses& classes = PatchClasses(),
+                               FilterTests tests = FilterTests::kAll);
 
 // The score floor of the points of patches `first_patch` on (their
 // patches' scores): `options.threshold`, raised to median - score_fence
