@@ -297,7 +297,6 @@ TEST(OptionSpec, CheckpointRecordOfTheVersion1MatchingIsTheOldOne) {
   v1.refill_cut = true;    // likewise
   v1.pmvs_passes = 0;
   v1.first_features_per_block = 0;
-  v1.visibility_only_filters = 0;
   EXPECT_EQ(OptionsJson(v1), old) << OptionsJson(v1).dump(2);
   const nlohmann::json defaults = OptionsJson(MatcherOptions{});
   EXPECT_NE(defaults, old);
