@@ -68,13 +68,15 @@ TEST_F(CliMpiTest, TwoRanksWriteTheCloudOfOneProcess) {
        {"cloud.las", "dsm.tif", "dsm.png", "ortho.tif", "report.json", "report.html"}) {
     EXPECT_TRUE(fs::exists(two / f)) << f;
   }
-  // Rank 0 alone prints the summary; the claims are gone.
+  // Rank 0 alone prints the summary; the claims and the images the ranks
+  // kept at the level are gone.
   size_t wrote = 0;
   for (size_t at = 0; (at = r2.out.find("wrote ", at)) != std::string::npos; ++at) ++wrote;
   EXPECT_EQ(wrote, 11u) << r2.out;
   for (const auto& e : fs::directory_iterator(two / "groups")) {
     EXPECT_NE(e.path().extension(), ".claim") << e.path();
   }
+  EXPECT_FALSE(fs::exists(two / "groups" / "levels"));
   const nlohmann::json report = nlohmann::json::parse(test::Slurp(two / "report.json"));
   EXPECT_EQ(report.value("mpi_ranks", 0), 2);
   ASSERT_EQ(report["groups"].size(), 2u);

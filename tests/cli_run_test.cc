@@ -491,6 +491,8 @@ TEST_F(CliBlockRunTest, ResumedRunWritesTheSameCloud) {
   ASSERT_EQ(a.exit_code, 0) << a.err;
   const nlohmann::json ja = Report(whole);
   ASSERT_EQ(ja.at("groups").size(), 2u) << ja.at("groups");
+  // The images the groups shared at the level are the run's scratch.
+  EXPECT_FALSE(fs::exists(whole / "groups" / "levels"));
 
   // Stopped after one group: its checkpoint only, no final output.
   const auto b1 = RunCli(Args(parts, "--max-groups 1"));
@@ -499,6 +501,7 @@ TEST_F(CliBlockRunTest, ResumedRunWritesTheSameCloud) {
   EXPECT_TRUE(fs::exists(parts / "groups" / "group_001.json"));
   EXPECT_FALSE(fs::exists(parts / "groups" / "group_002.json"));
   EXPECT_FALSE(fs::exists(parts / "cloud.ply"));
+  EXPECT_FALSE(fs::exists(parts / "groups" / "levels"));
   // Resumed: the first group comes from its checkpoint, and the final cloud
   // is the uninterrupted run's, byte for byte.
   const auto b2 = RunCli(Args(parts));

@@ -9,6 +9,7 @@
 
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/image_io.h"
+#include "sapmvs/block/level_images.h"
 #include "sapmvs/io/raster_io.h"
 #include "sapmvs/match/match_group.h"
 #include "sapmvs/match/matcher_options.h"
@@ -33,7 +34,9 @@ double GdalBytesToMatch(const Block& block) {
 }
 
 MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
-                              const BlockGeometry* known_geometry) {
+                              const BlockGeometry* known_geometry, const LevelImageStore* levels) {
+  const LevelImageStore decode_each;
+  const LevelImageStore& store = levels ? *levels : decode_each;
   MatchGroupData group;
   group.origin = block.origin;
   const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
@@ -60,14 +63,13 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
       [&](long k) {
         const int id = ids[k];
         const BlockImage& bi = block.images.at(id);
-        LoadedImage loaded = LoadUndistorted(bi);
         MatchImage& im = images[k];
-        im.file = FileStamp::Of(bi.path).value_or(FileStamp{});
         im.name = bi.name;
         im.block_index = id;
-        im.camera = loaded.camera.Scaled(scale).Translated(block.origin);
-        const cv::Mat bgr =
-            ResampleToLevel(loaded.pixels, level, im.camera.width(), im.camera.height());
+        // The pinhole camera LoadUndistorted gives the pixels.
+        im.camera = bi.camera.Pinhole().Scaled(scale).Translated(block.origin);
+        const cv::Mat bgr = store.Load(bi, level, im.camera.width(), im.camera.height());
+        im.file = FileStamp::Of(bi.path).value_or(FileStamp{});
         cv::cvtColor(bgr, grey8[k], cv::COLOR_BGR2GRAY);
       },
       1, kImagesReadAtOnce);
@@ -137,7 +139,8 @@ std::optional<FileStamp> FileStamp::Of(const std::filesystem::path& path) {
   return stamp;
 }
 
-cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level) {
+cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level,
+                         const LevelImageStore* levels) {
   const BlockImage& bi = block.images.at(image.block_index);
   // A file that cannot be stamped now is left to the read, which names
   // what is wrong with it.
@@ -147,6 +150,7 @@ cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level)
                 ": image file changed while its group was matched (expected the file that "
                 "was loaded: its points take their colours from it)");
   }
+  if (levels) return levels->Load(bi, level, image.camera.width(), image.camera.height());
   const LoadedImage loaded = LoadUndistorted(bi);
   return ResampleToLevel(loaded.pixels, level, image.camera.width(), image.camera.height());
 }

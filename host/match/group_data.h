@@ -17,6 +17,8 @@
 
 namespace sapmvs {
 
+class LevelImageStore;
+
 struct MatcherOptions;
 
 // A file's size and modification time, the two a replaced file changes.
@@ -58,17 +60,21 @@ struct MatchGroupData {
 // them. Throws Error naming the image for unreadable files.
 // `geometry`: EstimateBlockGeometry(block) when the caller has it (a
 // whole-block run loads many groups of one block; estimating it reads the
-// block's DEM each time), else nullptr and it is estimated here.
+// block's DEM each time), else nullptr and it is estimated here. `levels`:
+// the run's store of images at the level (level_images.h), else nullptr
+// and each image is decoded.
 MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
-                              const BlockGeometry* geometry = nullptr);
+                              const BlockGeometry* geometry = nullptr,
+                              const LevelImageStore* levels = nullptr);
 
 // The colour pixels of group image `image` (CV_8UC3, BGR), read again from
 // its file as LoadMatchGroup read it: the group keeps only grey levels
 // through the matching, and its points take their colours once they are
 // known. Throws Error naming the image for an unreadable file, or one whose
 // size or time differ from the load's (replaced during the run: its pixels
-// would not be the ones matched).
-cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level);
+// would not be the ones matched). `levels` as for LoadMatchGroup.
+cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level,
+                         const LevelImageStore* levels = nullptr);
 
 // Picks each image's views: images whose footprint overlaps its own at the
 // expected depth, most overlap first, at most kMaxViews - 1. As in PMVS2,

@@ -84,7 +84,8 @@ MatcherMemoryModel MatcherMemory() {
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, PatchKernels& kernels,
                        const BlockGeometry* geometry, const MatchProgressFn& on_progress,
-                       const std::vector<int>& view_ids, const GroundRegion& region) {
+                       const std::vector<int>& view_ids, const GroundRegion& region,
+                       const LevelImageStore* levels) {
   const std::string problem = options.Problem();
   if (!problem.empty()) throw Error("matcher options: expected " + problem);
   std::vector<int> ids = image_ids;
@@ -144,7 +145,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
 
   const size_t references = ids.size();
   ids.insert(ids.end(), view_ids.begin(), view_ids.end());
-  MatchGroupData group = LoadMatchGroup(block, ids, options.level, geometry);
+  MatchGroupData group = LoadMatchGroup(block, ids, options.level, geometry, levels);
   for (size_t i = references; i < group.images.size(); ++i) group.images[i].reference = false;
   SelectViews(options, &group);
   stats.images = static_cast<int>(group.images.size());
@@ -345,7 +346,8 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
     cloud.points.push_back(c);
     has_points[p.ref] = true;
   }
-  // The colours, from each reference image read again from its file: held
+  // The colours, from each reference image read again (from the run's store
+  // of images at the level where there is one, else its file): held
   // from the load on, the colour images were 3 bytes a pixel of the level
   // through the whole matching (38 MiB of Herz-Jesu-P8's 382 MiB peak), for
   // a read here that costs what the load's did (0.42 s on Herz-Jesu-P8).
@@ -359,7 +361,7 @@ MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
       static_cast<long>(group.images.size()),
       [&](long r) {
         if (!has_points[r]) return;
-        const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level);
+        const cv::Mat color = LoadColorAtLevel(block, group.images[r], options.level, levels);
         for (size_t i = 0; i < points.size(); ++i) {
           const DensePoint& d = points[i];
           if (keep[i] && patches[d.patch].ref == r)

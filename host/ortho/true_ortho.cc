@@ -13,6 +13,7 @@
 #include "ortho/ortho_depth_buffer.h"
 #include "ortho/ortho_surface.h"
 #include "sapmvs/block/image_io.h"
+#include "sapmvs/block/level_images.h"
 #include "sapmvs/util/error.h"
 #include "sapmvs/util/parallel_for.h"
 #include "sapmvs/util/thread_count.h"
@@ -150,7 +151,8 @@ long FillGaps(const GeoRaster& grid, std::vector<uint8_t>* rgba) {
 
 TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int level,
                         const OrthoOptions& options, double default_cell,
-                        const std::function<void(int, int)>& progress) {
+                        const std::function<void(int, int)>& progress,
+                        const LevelImageStore* levels) {
   if (const std::string p = options.Problem(); !p.empty()) {
     throw Error("orthophoto: expected " + p);
   }
@@ -254,8 +256,13 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
         static_cast<long>(n),
         [&](long j) {
           const OrthoView& v = views[used_views[first + j]];
-          const LoadedImage image = LoadUndistorted(block.images[v.image]);
-          loaded[j] = ResampleToLevel(image.pixels, level, v.camera.width(), v.camera.height());
+          if (levels) {
+            loaded[j] = levels->Load(block.images[v.image], level, v.camera.width(),
+                                     v.camera.height(), false);
+          } else {
+            const LoadedImage image = LoadUndistorted(block.images[v.image]);
+            loaded[j] = ResampleToLevel(image.pixels, level, v.camera.width(), v.camera.height());
+          }
           depths[j] = std::make_unique<OrthoDepthBuffer>(v.camera, dsm, v.dsm_cells, surface.walls,
                                                          tolerance);
         },

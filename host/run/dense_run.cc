@@ -23,6 +23,7 @@
 #include "run/run_report.h"
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/block_reader.h"
+#include "sapmvs/block/level_images.h"
 #include "sapmvs/io/las_io.h"
 #include "sapmvs/io/ply_io.h"
 #include "sapmvs/io/raster_io.h"
@@ -198,6 +199,10 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   for (const ImageGroup& group : plan.groups)
     centers.push_back(group.center + block.origin.head<2>());
   const double level_gsd = geometry.gsd_median * std::ldexp(1.0, options.matcher.level);
+  // The images at the level, decoded once for every group that reads them
+  // and for the orthophoto; removed once the outputs are written (by rank 0,
+  // which writes them, under mpirun).
+  const LevelImageStore levels(options.out / "groups" / "levels");
   int matched_now = 0;
   bool stopped = false;  // groups left for a later call (max_groups)
   for (int g = 0; g < n; ++g) {
@@ -229,8 +234,8 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
     MatchResult result = MatchGroup(
         block, plan.groups[g].images, options.matcher, *kernels, &geometry,
         [&](const MatchProgressEvent& e) { progress.Update(e); }, plan.groups[g].views,
-        owns_ground ? GroundRegion(centers, g, options.own_margin_gsd * level_gsd)
-                    : GroundRegion());
+        owns_ground ? GroundRegion(centers, g, options.own_margin_gsd * level_gsd) : GroundRegion(),
+        &levels);
     run.seconds = Since(t0);
     run.points = static_cast<long>(result.cloud.points.size());
     run.memory.peak_rss_bytes = PeakRssBytes();
@@ -256,6 +261,11 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   kernels.reset();
   ReleaseFreeMemory();
   if (!dispatch.merges()) return report;
+  // Also when the outputs fail: the copies are the run's scratch, not its.
+  struct ClearLevels {
+    const LevelImageStore& store;
+    ~ClearLevels() { store.Clear(); }
+  } clear_levels{levels};
   for (GroupRun& run : report.groups) {
     run.rank = report.ranks > 1 ? matched_by[run.index] : -1;
     if (run.rank <= 0 || !checkpoints.Done(run.index)) continue;
@@ -294,10 +304,12 @@ RunReport RunGroups(const RunOptions& options, GroupDispatch& dispatch) {
   if (!options.ortho.skip) {
     std::unique_ptr<Progress> bar;  // once the images to draw are known
     const TrueOrtho ortho = MakeTrueOrtho(
-        block, dsm, options.matcher.level, options.ortho, level_gsd, [&](int done, int total) {
+        block, dsm, options.matcher.level, options.ortho, level_gsd,
+        [&](int done, int total) {
           if (!bar) bar = std::make_unique<Progress>("orthophoto", total, options.matcher.progress);
           bar->Advance(1, std::to_string(done) + "/" + std::to_string(total) + " images");
-        });
+        },
+        &levels);
     if (bar) bar->Finish();
     WriteOrthoOutputs(ortho, options.out);
     report.ortho_cell = ortho.grid.cell_size;

@@ -21,6 +21,7 @@
 namespace sapmvs {
 
 struct BlockGeometry;
+class LevelImageStore;
 
 class PatchKernels;
 
@@ -35,14 +36,17 @@ struct MatchResult {
 // EstimateBlockGeometry(block) when the caller already has it, else nullptr.
 // `on_progress` hears each stage and wave; without it, options.progress
 // draws a status line of its own on a terminal. `region`: the ground the
-// group owns; no patch grows outside it. Throws Error for bad
-// options, unreadable images or fewer than 2 usable images.
+// group owns; no patch grows outside it. `levels`: the run's store of
+// images at the level (level_images.h), which groups share; nullptr decodes
+// each image for this group. Throws Error for bad options, unreadable images
+// or fewer than 2 usable images.
 MatchResult MatchGroup(const Block& block, const std::vector<int>& image_ids,
                        const MatcherOptions& options, PatchKernels& kernels,
                        const BlockGeometry* geometry = nullptr,
                        const MatchProgressFn& on_progress = {},
                        const std::vector<int>& view_ids = {},
-                       const GroundRegion& region = GroundRegion());
+                       const GroundRegion& region = GroundRegion(),
+                       const LevelImageStore* levels = nullptr);
 
 // Images the load and the colours' read decode side by side (fewer on fewer
 // host threads): each is one core's work for tens of milliseconds, and each

@@ -25,6 +25,8 @@
 
 namespace sapmvs {
 
+class LevelImageStore;
+
 struct TrueOrtho {
   // The ortho's cells: size, geotransform and CRS (its values are unused).
   GeoRaster grid;
@@ -39,10 +41,13 @@ struct TrueOrtho {
 // The ortho of `block` at pyramid `level` over `dsm` (block CRS, world
 // coordinates, the cameras' frame), on cells of options.cell_size, or of
 // `default_cell` for 0. `progress(done, total)` is called as each image's
-// colours are taken. Throws sapmvs::Error for bad options, an ortho over
-// 2^28 cells, or an image that cannot be read (naming its file).
+// colours are taken. `levels`: the run's images at `level` (level_images.h),
+// read from there where the matching kept them; else each is decoded.
+// Throws sapmvs::Error for bad options, an ortho over 2^28 cells, or an
+// image that cannot be read (naming its file).
 TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& dsm, int level,
                         const OrthoOptions& options, double default_cell,
-                        const std::function<void(int, int)>& progress = {});
+                        const std::function<void(int, int)>& progress = {},
+                        const LevelImageStore* levels = nullptr);
 
 }  // namespace sapmvs
