@@ -33,6 +33,16 @@ nlohmann::json ToJson(const OrthoTruth& r, const std::string& ortho) {
   };
   nlohmann::json tiles = nlohmann::json::array();
   for (const auto& t : r.tile_shifts) tiles.push_back({t.col, t.row, t.east, t.north});
+  nlohmann::json wrong = nlohmann::json::array();
+  for (const auto& w : r.wrong_cells) {
+    wrong.push_back({{"col", w.col},
+                     {"row", w.row},
+                     {"x", w.x},
+                     {"y", w.y},
+                     {"side", w.high ? "roof" : "ground"},
+                     {"dsm_right", w.dsm_right},
+                     {"step_right", w.step_right}});
+  }
   return {{"ortho", ortho},
           {"gsd", r.gsd},
           {"ortho_cell", r.ortho_cell},
@@ -55,7 +65,8 @@ nlohmann::json ToJson(const OrthoTruth& r, const std::string& ortho) {
           {"ghost_high_dsm_right", side(r.high_right)},
           {"ghost_low_dsm_right", side(r.low_right)},
           {"ghost_high_step_right", side(r.high_step_right)},
-          {"ghost_low_step_right", side(r.low_step_right)}};
+          {"ghost_low_step_right", side(r.low_step_right)},
+          {"wrong_cells", wrong}};  // each edge cell of the wrong side
 }
 
 }  // namespace

@@ -232,6 +232,7 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
   // High, wrong, low, wrong; the same where the ortho's DSM is right; the
   // same where it is right on both sides.
   std::vector<std::array<long, 12>> rows(g.height, std::array<long, 12>{});
+  std::vector<std::vector<OrthoTruth::WrongCell>> wrong_rows(g.height);
   ParallelFor(g.height, [&](long row) {
     for (int col = 0; col < g.width; ++col) {
       const size_t i = static_cast<size_t>(row) * g.width + col;
@@ -269,14 +270,18 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
       ++rows[row][side];
       rows[row][side + 1] += wrong;
       const double tolerance = o.dsm_tolerance_gsd * out->gsd;
+      OrthoTruth::WrongCell cell{col, static_cast<int>(row), p.x(), p.y(), side == 0};
       if (ortho_dsm && std::abs(OrthoDsmHeight(*ortho_dsm, p.x(), p.y()) - h0) <= tolerance) {
         ++rows[row][4 + side];
         rows[row][4 + side + 1] += wrong;
+        cell.dsm_right = true;
         if (std::abs(OrthoDsmHeight(*ortho_dsm, q.x(), q.y()) - hq) <= tolerance) {
           ++rows[row][8 + side];
           rows[row][8 + side + 1] += wrong;
+          cell.step_right = true;
         }
       }
+      if (wrong) wrong_rows[row].push_back(cell);
     }
   });
   for (const auto& r : rows) {
@@ -287,6 +292,8 @@ void OrthoEdges(const ColorRaster& ortho, const ColorRaster& truth, const GeoRas
     out->high_step_right.cells += r[8], out->high_step_right.wrong += r[9];
     out->low_step_right.cells += r[10], out->low_step_right.wrong += r[11];
   }
+  for (const auto& r : wrong_rows)
+    out->wrong_cells.insert(out->wrong_cells.end(), r.begin(), r.end());
 }
 
 }  // namespace

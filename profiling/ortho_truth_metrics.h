@@ -135,6 +135,15 @@ struct OrthoTruth {
   // the step, so that a wrong colour is the ortho's doing, not the DSM's.
   EdgeSide high_right, low_right;
   EdgeSide high_step_right, low_step_right;
+  // Each wrong edge cell, to look at where they are: the ortho cell, its
+  // centre, and whether it is a roof's (high) and the DSM is right at it and
+  // across the step (with an ortho DSM).
+  struct WrongCell {
+    int col = 0, row = 0;
+    double x = 0, y = 0;
+    bool high = false, dsm_right = false, step_right = false;
+  };
+  std::vector<WrongCell> wrong_cells;
   double Coverage() const {
     return truth_cells > 0 ? static_cast<double>(covered_cells) / truth_cells : 0;
   }

@@ -187,6 +187,16 @@ TEST(OrthoTruth, RoofOnTheGroundBesideAWallIsGhosting) {
   const OrthoTruth rim = CompareOrthoToTruth(shrunk, s.truth, s.dsm);
   EXPECT_EQ(rim.high.wrong, 64);
   EXPECT_EQ(rim.low.wrong, 0);
+  // Each wrong cell is listed, on its side, at the roof's west edge.
+  ASSERT_EQ(rim.wrong_cells.size(), 64u);
+  for (const OrthoTruth::WrongCell& w : rim.wrong_cells) {
+    EXPECT_TRUE(w.high);
+    EXPECT_EQ(w.col, kRoofFirst);
+    EXPECT_FALSE(w.dsm_right);  // no ortho DSM given
+  }
+  size_t listed = 0;
+  for (const OrthoTruth::WrongCell& w : r.wrong_cells) listed += !w.high;
+  EXPECT_EQ(listed, static_cast<size_t>(r.low.wrong));
 }
 
 TEST(OrthoTruth, RefusesOtherCrsAndBadOptions) {
