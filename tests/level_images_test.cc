@@ -119,6 +119,14 @@ TEST_F(LevelImageStoreTest, ReadsWithoutKeepingWhereItCannotOrIsToldNotTo) {
   const LevelImageStore store(dir_ / "levels");
   EXPECT_TRUE(Same(Read(store, 0, 1, false), Decoded(0, 1)));
   EXPECT_FALSE(fs::exists(dir_ / "levels"));
+  // A disk that would keep less free than asked: nothing kept.
+  const LevelImageStore full(dir_ / "full", 1e30);
+  EXPECT_TRUE(Same(Read(full, 0, 1), Decoded(0, 1)));
+  EXPECT_EQ(Files(dir_ / "full"), 0);
+  // With room, the same store keeps it.
+  const LevelImageStore room(dir_ / "room", 0);
+  Read(room, 0, 1);
+  EXPECT_EQ(Files(dir_ / "room"), 1);
   // An image that cannot be read is named, as without the store.
   fs::remove(block_.images[1].path);
   try {

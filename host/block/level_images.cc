@@ -91,10 +91,18 @@ cv::Mat ReadCopy(const std::filesystem::path& path, const Header& expected) {
 // Written under a name of this process and thread, then renamed: a reader
 // sees a whole copy or none, and two ranks writing the same image leave
 // one of two equal copies. No fsync: a copy lost in a crash is decoded again.
-void WriteCopy(const std::filesystem::path& path, const Header& h, const cv::Mat& pixels) {
+// Not written where it would leave less than `min_free` bytes free (< 0:
+// 1 GiB and a tenth of the disk).
+void WriteCopy(const std::filesystem::path& path, const Header& h, const cv::Mat& pixels,
+               double min_free) {
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);
   if (ec) return;
+  const std::filesystem::space_info space = std::filesystem::space(path.parent_path(), ec);
+  if (ec) return;
+  if (min_free < 0) min_free = 1073741824.0 + 0.1 * static_cast<double>(space.capacity);
+  const double bytes = static_cast<double>(pixels.total() * pixels.elemSize()) + 4096;
+  if (static_cast<double>(space.available) - bytes < min_free) return;
   std::ostringstream tmp_name;
   tmp_name << path.filename().string() << ".tmp." << ::getpid() << "."
            << std::hash<std::thread::id>{}(std::this_thread::get_id());
@@ -126,7 +134,8 @@ void WriteCopy(const std::filesystem::path& path, const Header& h, const cv::Mat
 
 }  // namespace
 
-LevelImageStore::LevelImageStore(std::filesystem::path dir) : dir_(std::move(dir)) {}
+LevelImageStore::LevelImageStore(std::filesystem::path dir, double min_free_bytes)
+    : dir_(std::move(dir)), min_free_bytes_(min_free_bytes) {}
 
 cv::Mat LevelImageStore::Load(const BlockImage& image, int level, int width, int height,
                               bool keep) const {
@@ -139,7 +148,7 @@ cv::Mat LevelImageStore::Load(const BlockImage& image, int level, int width, int
   }
   const LoadedImage loaded = LoadUndistorted(image);
   cv::Mat pixels = ResampleToLevel(loaded.pixels, level, width, height);
-  if (expected && keep) WriteCopy(path, *expected, pixels);
+  if (expected && keep) WriteCopy(path, *expected, pixels, min_free_bytes_);
   return pixels;
 }
 

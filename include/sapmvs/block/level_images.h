@@ -18,8 +18,12 @@ namespace sapmvs {
 class LevelImageStore {
  public:
   // Keeps the images under `dir` (made when first needed); an empty `dir`
-  // keeps none: each read decodes.
-  explicit LevelImageStore(std::filesystem::path dir = {});
+  // keeps none: each read decodes. A copy is kept only while the disk
+  // keeps `min_free_bytes` free after it (by default 1 GiB and a tenth of
+  // the disk): on a block of thousands of large images the copies could
+  // otherwise take the room the outputs need (1,000 images of 20 MP at
+  // level 1 are 15 GB of them).
+  explicit LevelImageStore(std::filesystem::path dir = {}, double min_free_bytes = -1);
 
   // The 8-bit BGR pixels of `image`, undistorted and at pyramid `level`, of
   // size `width` x `height` (its pinhole camera scaled to the level), as
@@ -39,6 +43,7 @@ class LevelImageStore {
 
  private:
   std::filesystem::path dir_;
+  double min_free_bytes_;
 };
 
 }  // namespace sapmvs
