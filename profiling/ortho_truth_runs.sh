@@ -37,9 +37,10 @@ for preset in small city campus; do
     > /dev/null
   "$ortho_truth" "$work/floor_$preset.tif" --truth "$block/truth" \
     --dsm "$work/floor_dsm_$preset.tif" --json "$work/floor_$preset.json" > /dev/null
-  python3 - "$preset" "$run/report.json" "$work/truth_$preset.json" <<'PY'
+  python3 - "$preset" "$run/report.json" "$work/truth_$preset.json" "$work/floor_$preset.json" \
+    "$work/floor_rows.md" <<'PY'
 import json, sys
-preset, report, truth = sys.argv[1:]
+preset, report, truth, floor, floor_rows = sys.argv[1:]
 r, t = json.load(open(report)), json.load(open(truth))
 o = r["ortho"]
 stages = {s["stage"]: s["wall_seconds"] for s in r["stages"]}
@@ -53,8 +54,8 @@ print(f'| `{preset}` | {o["width"]:,} × {o["height"]:,} of {o["cell"]:.3f} m '
       f'{share(t["ghost_high_dsm_right"])} / {share(t["ghost_low_dsm_right"])} | '
       f'{share(t["ghost_high_step_right"])} / {share(t["ghost_low_step_right"])} | '
       f'{stages["run ortho"]:.1f} / {r["total_seconds"]:.1f} s |')
-t = json.load(open(truth.replace("truth_", "floor_")))
-with open(truth.replace(f"truth_{preset}.json", "floor_rows.md"), "a") as rows:
+t = json.load(open(floor))
+with open(floor_rows, "a") as rows:
     print(f'| `{preset}`, the truth on the run\'s DSM cells | | | '
           f'{t["shift_median_gsd"]:.2f} / {t["shift_p95_gsd"]:.2f} ({t["tiles_used"]} tiles) | '
           f'{t["luminance_median"]:.1f} / {t["luminance_p95"]:.1f}, {t["luminance_bias"]:+.1f} | '

@@ -135,6 +135,16 @@ cv::Mat Undistort(const cv::Mat& image, const Intrinsics& intrinsics) {
   return out;
 }
 
+std::optional<FileStamp> FileStamp::Of(const std::filesystem::path& path) {
+  std::error_code ec;
+  FileStamp stamp;
+  stamp.size = std::filesystem::file_size(path, ec);
+  if (ec) return std::nullopt;
+  stamp.time = std::filesystem::last_write_time(path, ec);
+  if (ec) return std::nullopt;
+  return stamp;
+}
+
 LoadedImage LoadUndistorted(const BlockImage& image) {
   LoadedImage out;
   out.pixels = Undistort(LoadImage(image), image.camera.intrinsics());

@@ -31,16 +31,14 @@ struct Header {
 };
 
 std::optional<Header> Expected(const BlockImage& image, int level, int width, int height) {
-  std::error_code size_error, time_error;
-  const std::uintmax_t size = std::filesystem::file_size(image.path, size_error);
-  const auto time = std::filesystem::last_write_time(image.path, time_error);
-  if (size_error || time_error) return std::nullopt;
+  const std::optional<FileStamp> stamp = FileStamp::Of(image.path);
+  if (!stamp) return std::nullopt;
   Header h;
   h.level = level;
   h.width = width;
   h.height = height;
-  h.file_size = size;
-  h.file_time = static_cast<int64_t>(time.time_since_epoch().count());
+  h.file_size = stamp->size;
+  h.file_time = static_cast<int64_t>(stamp->time.time_since_epoch().count());
   h.path = image.path.string();
   return h;
 }
@@ -141,14 +139,11 @@ cv::Mat LevelImageStore::Load(const BlockImage& image, int level, int width, int
                               bool keep) const {
   const std::optional<Header> expected =
       dir_.empty() ? std::nullopt : Expected(image, level, width, height);
-  const std::filesystem::path path = expected ? CopyPath(dir_, image, level) : dir_;
-  if (expected) {
-    cv::Mat kept = ReadCopy(path, *expected);
-    if (!kept.empty()) return kept;
-  }
-  const LoadedImage loaded = LoadUndistorted(image);
-  cv::Mat pixels = ResampleToLevel(loaded.pixels, level, width, height);
-  if (expected && keep) WriteCopy(path, *expected, pixels, min_free_bytes_);
+  if (!expected) return ResampleToLevel(LoadUndistorted(image).pixels, level, width, height);
+  const std::filesystem::path path = CopyPath(dir_, image, level);
+  if (cv::Mat kept = ReadCopy(path, *expected); !kept.empty()) return kept;
+  cv::Mat pixels = ResampleToLevel(LoadUndistorted(image).pixels, level, width, height);
+  if (keep) WriteCopy(path, *expected, pixels, min_free_bytes_);
   return pixels;
 }
 

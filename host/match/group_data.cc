@@ -129,16 +129,6 @@ MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, i
   return group;
 }
 
-std::optional<FileStamp> FileStamp::Of(const std::filesystem::path& path) {
-  std::error_code ec;
-  FileStamp stamp;
-  stamp.size = std::filesystem::file_size(path, ec);
-  if (ec) return std::nullopt;
-  stamp.time = std::filesystem::last_write_time(path, ec);
-  if (ec) return std::nullopt;
-  return stamp;
-}
-
 cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level,
                          const LevelImageStore* levels) {
   const BlockImage& bi = block.images.at(image.block_index);
@@ -150,9 +140,9 @@ cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level,
                 ": image file changed while its group was matched (expected the file that "
                 "was loaded: its points take their colours from it)");
   }
-  if (levels) return levels->Load(bi, level, image.camera.width(), image.camera.height());
-  const LoadedImage loaded = LoadUndistorted(bi);
-  return ResampleToLevel(loaded.pixels, level, image.camera.width(), image.camera.height());
+  const LevelImageStore decode_each;
+  return (levels ? *levels : decode_each)
+      .Load(bi, level, image.camera.width(), image.camera.height());
 }
 
 void SelectViews(const MatcherOptions& /*options*/, MatchGroupData* group) {

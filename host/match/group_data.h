@@ -14,22 +14,13 @@
 #include "sapmvs/block/block.h"
 #include "sapmvs/block/block_geometry.h"
 #include "sapmvs/block/camera.h"
+#include "sapmvs/block/image_io.h"
 
 namespace sapmvs {
 
 class LevelImageStore;
 
 struct MatcherOptions;
-
-// A file's size and modification time, the two a replaced file changes.
-struct FileStamp {
-  std::uintmax_t size = 0;
-  std::filesystem::file_time_type time{};
-  bool operator==(const FileStamp& o) const { return size == o.size && time == o.time; }
-  bool operator!=(const FileStamp& o) const { return !(*this == o); }
-  // None where either cannot be read (a removed file).
-  static std::optional<FileStamp> Of(const std::filesystem::path& path);
-};
 
 struct MatchImage {
   std::string name;

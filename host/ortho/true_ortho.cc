@@ -153,6 +153,8 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
                         const OrthoOptions& options, double default_cell,
                         const std::function<void(int, int)>& progress,
                         const LevelImageStore* levels) {
+  const LevelImageStore decode_each;
+  const LevelImageStore& store = levels ? *levels : decode_each;
   if (const std::string p = options.Problem(); !p.empty()) {
     throw Error("orthophoto: expected " + p);
   }
@@ -256,13 +258,8 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
         static_cast<long>(n),
         [&](long j) {
           const OrthoView& v = views[used_views[first + j]];
-          if (levels) {
-            loaded[j] = levels->Load(block.images[v.image], level, v.camera.width(),
-                                     v.camera.height(), false);
-          } else {
-            const LoadedImage image = LoadUndistorted(block.images[v.image]);
-            loaded[j] = ResampleToLevel(image.pixels, level, v.camera.width(), v.camera.height());
-          }
+          loaded[j] =
+              store.Load(block.images[v.image], level, v.camera.width(), v.camera.height(), false);
           depths[j] = std::make_unique<OrthoDepthBuffer>(v.camera, dsm, v.dsm_cells, surface.walls,
                                                          tolerance);
         },

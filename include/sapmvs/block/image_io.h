@@ -3,14 +3,26 @@
 // through OpenCV, undistortion once at load so the matcher sees pinhole images.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sapmvs/block/block.h"
 
 namespace sapmvs {
+
+// A file's size and modification time, the two a replaced file changes.
+struct FileStamp {
+  std::uintmax_t size = 0;
+  std::filesystem::file_time_type time{};
+  bool operator==(const FileStamp& o) const { return size == o.size && time == o.time; }
+  bool operator!=(const FileStamp& o) const { return !(*this == o); }
+  // None where either cannot be read (a removed file).
+  static std::optional<FileStamp> Of(const std::filesystem::path& path);
+};
 
 struct ImageSize {
   int width = 0;

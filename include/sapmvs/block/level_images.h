@@ -39,8 +39,6 @@ class LevelImageStore {
   // Removes the kept copies and their folder; nothing when there are none.
   void Clear() const;
 
-  const std::filesystem::path& dir() const { return dir_; }
-
  private:
   std::filesystem::path dir_;
   double min_free_bytes_;
