@@ -9,6 +9,14 @@
 //                [--modes sapmvs,pmvs] [--max-images N] [--markdown FILE]
 //                [--pmvs2 PATH] [--sapmvs PATH] [--exported PMVS_DIR]
 //                [--pmvs2-cloud PLY] [--run-flags "FLAGS"]
+//                [--openmvs [--openmvs-bin DIR] | --openmvs-cloud PLY]
+//
+// --openmvs adds OpenMVS's DensifyPointCloud (CPU build) as a second anchor
+// on a COLMAP undistorted folder: a denser, smoother surface than PMVS2's
+// at several times its time; its row compares with PMVS2's like sapmvs's,
+// and the second table gives its noise and ground. Its time is
+// DensifyPointCloud's alone (InterfaceCOLMAP reads the folder first, as
+// `sapmvs export` writes PMVS2's).
 //
 // --pmvs2-cloud compares with the cloud of an earlier PMVS2 run on the same
 // folder (models/option.ply) instead of running PMVS2 again, to try sapmvs
@@ -74,8 +82,15 @@ constexpr double kSurfaceReachGsd = 4.0;
 struct Row {
   std::string name;  // "PMVS2" or "sapmvs --mode M"
   ChildUsage usage;
-  bool timed = true;                                 // false: a cloud of an earlier run
-  PointCloud cloud;                                  // world frame
+  bool timed = true;  // false: a cloud of an earlier run
+  PointCloud cloud;   // world frame
+  // Where the cloud is read from, once every tool has run, and the offset
+  // that takes it to the world frame. Read between runs, a cloud raised the
+  // next child's peak RSS: fork() copies the benchmark's resident pages and
+  // exec() keeps their high-water mark in the child's ru_maxrss (OpenMVS's
+  // 8.6 M points, held while sapmvs ran, made its 252 MiB read 443).
+  fs::path cloud_file;
+  Eigen::Vector3d cloud_offset = Eigen::Vector3d::Zero();
   std::optional<double> from_pmvs2[2], to_pmvs2[2];  // at 1 and 2 GSD
   // Within 2 GSD of the other cloud's surface: of a point of it within
   // kSurfaceReachGsd, along its normal. PMVS2 samples every second pixel, so
@@ -131,19 +146,44 @@ bool IsExecutable(const fs::path& p) {
   return fs::is_regular_file(p) && access(p.c_str(), X_OK) == 0;
 }
 
-// build/anchors/ is where PMVS2 is built by hand (never committed); any
-// executable pmvs2 below it will do.
-fs::path FindPmvs2(const fs::path& build) {
+// build/anchors/ is where the anchors are built by hand (never committed);
+// any executable `name` below it will do.
+fs::path FindAnchor(const fs::path& build, const std::string& name) {
   const fs::path anchors = build / "anchors";
   std::error_code ec;
   if (fs::is_directory(anchors)) {
     for (auto it = fs::recursive_directory_iterator(anchors, ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-      if (it->path().filename() == "pmvs2" && IsExecutable(it->path())) return it->path();
+      if (it->path().filename() == name && IsExecutable(it->path())) return it->path();
     }
   }
+  return {};
+}
+
+fs::path FindPmvs2(const fs::path& build) {
+  if (fs::path found = FindAnchor(build, "pmvs2"); !found.empty()) return found;
   if (const char* env = std::getenv("SAPMVS_PMVS2"); env && IsExecutable(env)) return env;
   return {};
+}
+
+// OpenMVS's DensifyPointCloud, with InterfaceCOLMAP beside it
+// (profiling/anchors/build_openmvs.sh), else in the folder $SAPMVS_OPENMVS.
+fs::path FindOpenMvs(const fs::path& build) {
+  fs::path found = FindAnchor(build, "DensifyPointCloud");
+  if (found.empty()) {
+    if (const char* env = std::getenv("SAPMVS_OPENMVS"))
+      found = fs::path(env) / "DensifyPointCloud";
+  }
+  if (!IsExecutable(found) || !IsExecutable(found.parent_path() / "InterfaceCOLMAP")) return {};
+  return found;
+}
+
+// OpenMVS reads COLMAP's undistorted folder (images/, sparse/) and needs its
+// points' tracks to choose each image's neighbours, which an export of
+// sapmvs does not write: only such a folder is given to it.
+bool IsColmapUndistorted(const fs::path& block) {
+  std::error_code ec;
+  return fs::is_directory(block / "images", ec) && fs::is_directory(block / "sparse", ec);
 }
 
 std::vector<fs::path> CameraFiles(const fs::path& pmvs) {
@@ -360,6 +400,20 @@ int main(int argc, char** argv) {
   app.add_flag("--shift-pmvs2-pyramid", shift_pyramid,
                "Give PMVS2 matrices shifted by (2^level - 1)/2 px, undoing its pyramid's offset "
                "(OUT/pmvs2_shifted)");
+  bool openmvs_run = false;
+  app.add_flag("--openmvs", openmvs_run,
+               "Also run OpenMVS's DensifyPointCloud at --level and --threads (built by "
+               "profiling/anchors/build_openmvs.sh, else in the folder $SAPMVS_OPENMVS) on BLOCK, "
+               "which must be COLMAP's undistorted folder: a second anchor row");
+  std::string openmvs_bin;
+  app.add_option("--openmvs-bin", openmvs_bin,
+                 "Folder holding DensifyPointCloud and InterfaceCOLMAP for --openmvs (default: "
+                 "build/anchors/**, else $SAPMVS_OPENMVS)");
+  std::string openmvs_cloud;
+  app.add_option("--openmvs-cloud", openmvs_cloud,
+                 "Compare with this cloud of an earlier DensifyPointCloud run on BLOCK "
+                 "(scene_dense.ply) instead of running it; its row has no times")
+      ->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
   try {
     if (level < 0 || threads < 1 || max_images < 0) {
@@ -368,7 +422,30 @@ int main(int argc, char** argv) {
     if (again && !pmvs2_cloud.empty()) {
       throw Error("expected --pmvs2-again without --pmvs2-cloud (it runs PMVS2 twice itself)");
     }
+    if (openmvs_run && !openmvs_cloud.empty()) {
+      throw Error("expected --openmvs or --openmvs-cloud, not both");
+    }
+    if (openmvs_run && !IsColmapUndistorted(block_path)) {
+      throw Error(block_path +
+                  ": expected COLMAP's undistorted folder (images/, sparse/) for --openmvs");
+    }
     const fs::path build = BuildDir();
+    if (!openmvs_bin.empty() && !openmvs_run) throw Error("expected --openmvs-bin with --openmvs");
+    fs::path openmvs;
+    if (!openmvs_bin.empty()) {
+      openmvs = fs::path(openmvs_bin) / "DensifyPointCloud";
+      if (!IsExecutable(openmvs) || !IsExecutable(fs::path(openmvs_bin) / "InterfaceCOLMAP")) {
+        throw Error(openmvs_bin +
+                    ": expected executables DensifyPointCloud and InterfaceCOLMAP (--openmvs-bin)");
+      }
+    } else if (openmvs_run) {
+      openmvs = FindOpenMvs(build);
+    }
+    if (openmvs_run && openmvs.empty()) {
+      throw Error("--openmvs: no DensifyPointCloud with InterfaceCOLMAP beside it under " +
+                  (build / "anchors").string() +
+                  " or in $SAPMVS_OPENMVS (profiling/anchors/build_openmvs.sh builds them)");
+    }
     const fs::path sapmvs = sapmvs_path.empty() ? build / "sapmvs" : fs::path(sapmvs_path);
     if (!IsExecutable(sapmvs)) throw Error(sapmvs.string() + ": no sapmvs binary (--sapmvs)");
     const fs::path pmvs2 = pmvs2_path.empty() ? FindPmvs2(build) : fs::path(pmvs2_path);
@@ -402,13 +479,18 @@ int main(int argc, char** argv) {
     const double gsd_level = std::ldexp(gsd, level);
 
     std::vector<Row> rows;
-    if (!pmvs2_cloud.empty()) {
+    // A row for the cloud of an earlier run of `tool`: no times.
+    auto earlier = [&](const std::string& tool, const std::string& file,
+                       const Eigen::Vector3d& offset) {
       Row r;
-      r.name = "PMVS2 (" + pmvs2_cloud + ", earlier run)";
+      r.name = tool + " (" + file + ", earlier run)";
       r.timed = false;
-      r.cloud = ReadPly(pmvs2_cloud);
-      Translate(&r.cloud, origin);
+      r.cloud_file = file;
+      r.cloud_offset = offset;
       rows.push_back(std::move(r));
+    };
+    if (!pmvs2_cloud.empty()) {
+      earlier("PMVS2", pmvs2_cloud, origin);
     } else if (pmvs2.empty()) {
       std::cout << "PMVS2 not built: skipped\n";
     } else {
@@ -427,8 +509,12 @@ int main(int argc, char** argv) {
         // PMVS2 joins the prefix and its file names as strings.
         r.usage =
             Step({{pmvs2.string(), folder.string() + "/", "option"}, {}, logs / log}, &commands);
-        r.cloud = ReadPly(folder / "models" / "option.ply");
-        Translate(&r.cloud, origin);
+        r.cloud_file = folder / "models" / "option.ply";
+        if (!fs::is_regular_file(r.cloud_file)) {
+          throw Error(pmvs2.string() + " wrote no " + r.cloud_file.string() + "; see " +
+                      (logs / log).string());
+        }
+        r.cloud_offset = origin;
         rows.push_back(std::move(r));
       };
       run_pmvs2(shift_pyramid ? "PMVS2, P shifted for its pyramid" : "PMVS2", input, "pmvs2.log");
@@ -440,6 +526,42 @@ int main(int argc, char** argv) {
         WriteRepeatFolder(input, repeat);
         run_pmvs2(rows.back().name + ", second run", repeat, "pmvs2_again.log");
       }
+    }
+    // OpenMVS's cloud is in the COLMAP model's frame: sapmvs's world frame
+    // for COLMAP's own folder, the local one of a folder sapmvs exported.
+    const std::optional<ExportFrame> colmap_frame =
+        openmvs_run || !openmvs_cloud.empty() ? ReadExportFrame(block_path) : std::nullopt;
+    const Eigen::Vector3d colmap_origin =
+        colmap_frame ? colmap_frame->origin : Eigen::Vector3d::Zero();
+    if (!openmvs_cloud.empty()) {
+      earlier("OpenMVS", openmvs_cloud, colmap_origin);
+    } else if (openmvs_run) {
+      const fs::path work = fs::absolute(out / "openmvs");
+      const fs::path colmap = fs::absolute(block_path);
+      // DensifyPointCloud takes up the depth maps it finds in its folder.
+      fs::remove_all(work);
+      fs::create_directories(work);
+      Step({{(openmvs.parent_path() / "InterfaceCOLMAP").string(), "-i", colmap.string(), "-o",
+             (work / "scene.mvs").string(), "--image-folder", (colmap / "images").string() + "/",
+             "-w", work.string()},
+            {},
+            logs / "openmvs_interface.log"},
+           &commands);
+      Row r;
+      r.name = "OpenMVS DensifyPointCloud";
+      r.usage = Step({{openmvs.string(), "-i", (work / "scene.mvs").string(), "-o",
+                       (work / "scene_dense.mvs").string(), "--resolution-level", level_arg,
+                       "--max-threads", std::to_string(threads), "-w", work.string()},
+                      {},
+                      logs / "openmvs_densify.log"},
+                     &commands);
+      r.cloud_file = work / "scene_dense.ply";
+      if (!fs::is_regular_file(r.cloud_file)) {
+        throw Error(openmvs.string() + " wrote no " + r.cloud_file.string() + "; see " +
+                    (logs / "openmvs_densify.log").string());
+      }
+      r.cloud_offset = colmap_origin;
+      rows.push_back(std::move(r));
     }
     for (const std::string& mode : modes) {
       const fs::path run = out / ("run_" + mode);
@@ -457,12 +579,16 @@ int main(int argc, char** argv) {
       for (std::string flag; extra >> flag;) c.argv.push_back(flag);
       if (!run_flags.empty()) r.name += " " + run_flags;
       r.usage = Step(c, &commands);
-      r.cloud = ReadPly(run / "cloud.ply");
+      r.cloud_file = run / "cloud.ply";
       r.matching_busy = MatchingBusy(run / "report.json");
       r.run = run;
       rows.push_back(std::move(r));
     }
 
+    for (Row& r : rows) {
+      r.cloud = ReadPly(r.cloud_file);
+      Translate(&r.cloud, r.cloud_offset);
+    }
     const bool have_pmvs2 = !pmvs2.empty() || !pmvs2_cloud.empty();
     std::optional<Truth> truth;
     if (!truth_path.empty()) truth = ReadTruth(truth_path);
@@ -540,6 +666,8 @@ int main(int argc, char** argv) {
     if (!have_pmvs2) md << "PMVS2 not built: skipped.\n\n";
     if (!pmvs2_cloud.empty())
       md << "PMVS2's cloud from an earlier run: its times are not shown.\n\n";
+    if (!openmvs_cloud.empty())
+      md << "OpenMVS's cloud from an earlier run: its times are not shown.\n\n";
     md << "Commands (cwd " << fs::current_path().string() << "):\n\n```sh\n";
     for (const std::string& c : commands) md << c << "\n";
     md << "```\n\n";

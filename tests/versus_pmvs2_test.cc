@@ -7,6 +7,7 @@
 // and writes a cloud in PMVS2's own PLY format: four points 100 m apart,
 // three of them on its second run, so that the second run's row must show
 // 75 % of the first run's points covered and all of its own near the first's.
+// OpenMVS, the second anchor, gets stand-ins of the same kind.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
@@ -48,6 +49,33 @@ case "$prefix" in */pmvs2_again/) n=3;; *) n=4;; esac
   test "$n" = 4 && printf '100 100 0 0 0 1 120 150 90 0.9\n'
 } > "${prefix}models/$option.ply"
 echo "stand-in pmvs2: $n points"
+)";
+
+// Stand-ins for OpenMVS's two programs, which check what the real ones would
+// be given and write, in OpenMVS's PLY layout (normals, colours, then its
+// list properties), the stand-in PMVS2's four points in the COLMAP folder's
+// frame: PMVS2's whole cloud covered by it, once each frame is right.
+constexpr const char* kStandInInterfaceColmap = R"(#!/bin/sh
+set -e
+test "$1" = -i && test -d "$2/images" && test -d "$2/sparse" || { echo "stand-in InterfaceCOLMAP: -i $2 is no COLMAP folder" >&2; exit 2; }
+test "$3" = -o && test "$5" = --image-folder && test "$6" = "$2/images/" && test "$7" = -w || { echo "stand-in InterfaceCOLMAP: arguments $*" >&2; exit 2; }
+echo scene > "$4"
+)";
+
+constexpr const char* kStandInDensify = R"(#!/bin/sh
+set -e
+test "$1" = -i && test -f "$2" || { echo "stand-in DensifyPointCloud: no scene $2" >&2; exit 2; }
+test "$5 $6 $7 $8 $9" = "--resolution-level 1 --max-threads 1 -w" || { echo "stand-in DensifyPointCloud: arguments $*" >&2; exit 2; }
+shift 9
+{
+  printf 'ply\nformat ascii 1.0\nelement vertex 4\n'
+  printf 'property float x\nproperty float y\nproperty float z\n'
+  printf 'property float nx\nproperty float ny\nproperty float nz\n'
+  printf 'property uchar red\nproperty uchar green\nproperty uchar blue\n'
+  printf 'property list uchar uint view_indices\nproperty list uchar float points_weights\nend_header\n'
+  printf '0 0 0 0 0 1 120 150 90 2 0 1 2 0.5 0.5\n100 0 0 0 0 1 120 150 90 1 2 1 1.0\n'
+  printf '0 100 0 0 0 1 120 150 90 2 1 2 2 0.5 0.5\n100 100 0 0 0 1 120 150 90 0 0\n'
+} > "$1/scene_dense.ply"
 )";
 
 // The cells of the markdown table's row whose first cell is `name`; empty
@@ -169,6 +197,51 @@ TEST_F(VersusPmvs2Test, RunsPmvs2TwiceAndComparesEachCloudWithTheFirst) {
             std::string::npos)
       << markdown;
   EXPECT_NE(markdown.find(again.string() + "/ option"), std::string::npos) << markdown;
+}
+
+TEST_F(VersusPmvs2Test, RunsOpenMvsOnAColmapFolderAsASecondAnchor) {
+  // A COLMAP folder as sapmvs exports it, in a local frame: the cloud comes
+  // back to the world frame through the export's side file, as PMVS2's does.
+  const fs::path colmap = dir_ / "colmap";
+  const test::CliResult e = test::RunCli("export " + block_.string() + " --format colmap --out " +
+                                         colmap.string() + " -q");
+  ASSERT_EQ(e.exit_code, 0) << e.err;
+  const fs::path bin = dir_ / "openmvs";
+  fs::create_directories(bin);
+  std::ofstream(bin / "InterfaceCOLMAP") << kStandInInterfaceColmap;
+  std::ofstream(bin / "DensifyPointCloud") << kStandInDensify;
+  for (const char* name : {"InterfaceCOLMAP", "DensifyPointCloud"}) {
+    fs::permissions(bin / name, fs::perms::owner_all, fs::perm_options::add);
+  }
+  block_ = colmap;
+  const fs::path md = dir_ / "table.md";
+  const test::CliResult r = Versus("--modes sapmvs --openmvs --openmvs-bin " + bin.string() +
+                                   " --markdown " + md.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string markdown = test::Slurp(md);
+  const std::vector<std::string> openmvs = Row(markdown, "OpenMVS DensifyPointCloud");
+  const std::vector<std::string> first = Row(markdown, "PMVS2");
+  ASSERT_FALSE(first.empty()) << markdown;
+  ASSERT_EQ(openmvs.size(), first.size()) << markdown;
+  EXPECT_NE(openmvs[1], "–") << "DensifyPointCloud is timed";
+  EXPECT_EQ(openmvs[9], "4");
+  EXPECT_EQ(openmvs[10], "100.0 %") << markdown;
+  EXPECT_EQ(openmvs[12], "100.0 %") << markdown;
+  // In the second table, beside PMVS2 and sapmvs.
+  const std::string surface = markdown.substr(markdown.find("| tool / mode | points |"));
+  EXPECT_FALSE(Row(surface, "OpenMVS DensifyPointCloud").empty()) << surface;
+  EXPECT_NE(markdown.find((bin / "InterfaceCOLMAP").string() + " -i " + colmap.string()),
+            std::string::npos)
+      << markdown;
+}
+
+TEST_F(VersusPmvs2Test, RefusesOpenMvsOnAFolderItCannotRead) {
+  // The simulated block is a block.yaml, not COLMAP's undistorted folder.
+  const test::CliResult r = Versus("--openmvs --openmvs-bin " + dir_.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(test::CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("COLMAP's undistorted folder"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out")) << "refused before any work";
 }
 
 TEST_F(VersusPmvs2Test, AFailingPmvs2EndsTheBenchmarkNamingItsLog) {
