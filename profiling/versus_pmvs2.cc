@@ -88,7 +88,8 @@ struct Row {
   // that takes it to the world frame. Read between runs, a cloud raised the
   // next child's peak RSS: fork() copies the benchmark's resident pages and
   // exec() keeps their high-water mark in the child's ru_maxrss (OpenMVS's
-  // 8.6 M points, held while sapmvs ran, made its 252 MiB read 443).
+  // 8.6 M points, held while sapmvs ran, made its peak read 443 MiB, 263
+  // without them).
   fs::path cloud_file;
   Eigen::Vector3d cloud_offset = Eigen::Vector3d::Zero();
   std::optional<double> from_pmvs2[2], to_pmvs2[2];  // at 1 and 2 GSD
@@ -166,16 +167,30 @@ fs::path FindPmvs2(const fs::path& build) {
   return {};
 }
 
-// OpenMVS's DensifyPointCloud, with InterfaceCOLMAP beside it
-// (profiling/anchors/build_openmvs.sh), else in the folder $SAPMVS_OPENMVS.
+// DensifyPointCloud in `dir` when InterfaceCOLMAP is beside it, both
+// executable; else empty.
+fs::path OpenMvsIn(const fs::path& dir) {
+  const fs::path densify = dir / "DensifyPointCloud";
+  if (!IsExecutable(densify) || !IsExecutable(dir / "InterfaceCOLMAP")) return {};
+  return densify;
+}
+
+// OpenMVS's programs as profiling/anchors/build_openmvs.sh leaves them, else
+// in the folder $SAPMVS_OPENMVS.
 fs::path FindOpenMvs(const fs::path& build) {
-  fs::path found = FindAnchor(build, "DensifyPointCloud");
-  if (found.empty()) {
-    if (const char* env = std::getenv("SAPMVS_OPENMVS"))
-      found = fs::path(env) / "DensifyPointCloud";
+  if (fs::path found = FindAnchor(build, "DensifyPointCloud"); !found.empty()) {
+    return OpenMvsIn(found.parent_path());
   }
-  if (!IsExecutable(found) || !IsExecutable(found.parent_path() / "InterfaceCOLMAP")) return {};
-  return found;
+  if (const char* env = std::getenv("SAPMVS_OPENMVS")) return OpenMvsIn(env);
+  return {};
+}
+
+// The cloud `program` should have written, or an error naming its log.
+fs::path WrittenCloud(const fs::path& cloud, const fs::path& program, const fs::path& log) {
+  if (!fs::is_regular_file(cloud)) {
+    throw Error(program.string() + " wrote no " + cloud.string() + "; see " + log.string());
+  }
+  return cloud;
 }
 
 // OpenMVS reads COLMAP's undistorted folder (images/, sparse/) and needs its
@@ -433,8 +448,8 @@ int main(int argc, char** argv) {
     if (!openmvs_bin.empty() && !openmvs_run) throw Error("expected --openmvs-bin with --openmvs");
     fs::path openmvs;
     if (!openmvs_bin.empty()) {
-      openmvs = fs::path(openmvs_bin) / "DensifyPointCloud";
-      if (!IsExecutable(openmvs) || !IsExecutable(fs::path(openmvs_bin) / "InterfaceCOLMAP")) {
+      openmvs = OpenMvsIn(openmvs_bin);
+      if (openmvs.empty()) {
         throw Error(openmvs_bin +
                     ": expected executables DensifyPointCloud and InterfaceCOLMAP (--openmvs-bin)");
       }
@@ -509,11 +524,7 @@ int main(int argc, char** argv) {
         // PMVS2 joins the prefix and its file names as strings.
         r.usage =
             Step({{pmvs2.string(), folder.string() + "/", "option"}, {}, logs / log}, &commands);
-        r.cloud_file = folder / "models" / "option.ply";
-        if (!fs::is_regular_file(r.cloud_file)) {
-          throw Error(pmvs2.string() + " wrote no " + r.cloud_file.string() + "; see " +
-                      (logs / log).string());
-        }
+        r.cloud_file = WrittenCloud(folder / "models" / "option.ply", pmvs2, logs / log);
         r.cloud_offset = origin;
         rows.push_back(std::move(r));
       };
@@ -555,11 +566,7 @@ int main(int argc, char** argv) {
                       {},
                       logs / "openmvs_densify.log"},
                      &commands);
-      r.cloud_file = work / "scene_dense.ply";
-      if (!fs::is_regular_file(r.cloud_file)) {
-        throw Error(openmvs.string() + " wrote no " + r.cloud_file.string() + "; see " +
-                    (logs / "openmvs_densify.log").string());
-      }
+      r.cloud_file = WrittenCloud(work / "scene_dense.ply", openmvs, logs / "openmvs_densify.log");
       r.cloud_offset = colmap_origin;
       rows.push_back(std::move(r));
     }

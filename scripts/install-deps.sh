@@ -35,20 +35,7 @@ PACKAGES=(
 # The tests that open report.html in a headless browser (12 s of apt).
 [ "$build_only" = 1 ] || PACKAGES+=(clang libclang-rt-14-dev libomp-dev llvm chromium)
 
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#PACKAGES[@]} packages present"
-else
-  echo "install-deps: installing ${missing[*]}"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-  echo "install-deps: done"
-fi
+bash "$(dirname "$0")/apt-install.sh" install-deps "${PACKAGES[@]}"
 [ "$build_only" = 0 ] || exit 0
 
 # The independent LAS readers the tests check cloud.las with, from npm: copc.js
@@ -57,6 +44,8 @@ fi
 # build/npm, never system-wide. Without the npm registry the LAS test says
 # skipped; nothing else needs them.
 # Node and npm only for that test, so a failure here does not stop the build.
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 if ! command -v npm >/dev/null 2>&1; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends nodejs npm \
     >/dev/null 2>&1 || echo "install-deps: warning: could not install nodejs/npm"

@@ -16,18 +16,20 @@ if [ $# -lt 2 ] || [ $# -gt 3 ]; then
   echo "usage: $0 openMVS vcglib [BUILD_DIR]" >&2
   exit 2
 fi
-src=$(cd "$1" 2>/dev/null && pwd) || {
-  echo "build_openmvs: $1: no such folder (expected a checkout of openMVS)" >&2
-  exit 2
+# The absolute path of folder $1, or a line naming it and what $2 says was
+# expected there.
+folder() {
+  (cd "$1" 2>/dev/null && pwd) || {
+    echo "build_openmvs: $1: no such folder (expected $2)" >&2
+    exit 2
+  }
 }
+src=$(folder "$1" "a checkout of openMVS")
 if [ ! -f "$src/CMakeLists.txt" ] || [ ! -d "$src/apps/DensifyPointCloud" ]; then
   echo "build_openmvs: $src: not openMVS (expected CMakeLists.txt and apps/DensifyPointCloud)" >&2
   exit 2
 fi
-vcg=$(cd "$2" 2>/dev/null && pwd) || {
-  echo "build_openmvs: $2: no such folder (expected vcglib's vcg, wrap and eigenlib)" >&2
-  exit 2
-}
+vcg=$(folder "$2" "vcglib's vcg, wrap and eigenlib")
 if [ ! -d "$vcg/vcg" ] || [ ! -d "$vcg/wrap" ]; then
   echo "build_openmvs: $vcg: not vcglib (expected its vcg and wrap folders)" >&2
   exit 2
@@ -36,22 +38,9 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${3:-$root/build}
 mkdir -p "$build/anchors"
 build=$(cd "$build" && pwd)
-packages="libcgal-dev libboost-iostreams-dev libboost-program-options-dev libboost-system-dev
-  libboost-serialization-dev libjpeg-dev libpng-dev libtiff-dev libopencv-dev libeigen3-dev"
-missing=""
-for p in $packages; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||
-    missing="$missing $p"
-done
-if [ -n "$missing" ]; then
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-  echo "build_openmvs: installing$missing"
-  $SUDO apt-get update -qq
-  # shellcheck disable=SC2086
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing \
-    >/dev/null
-fi
+bash "$root/scripts/apt-install.sh" build_openmvs libcgal-dev libboost-iostreams-dev \
+  libboost-program-options-dev libboost-system-dev libboost-serialization-dev libjpeg-dev \
+  libpng-dev libtiff-dev libopencv-dev libeigen3-dev
 work="$build/anchors/openmvs-build"
 cmake -S "$src" -B "$work" -DCMAKE_BUILD_TYPE=Release -DVCG_ROOT="$vcg" \
   -DOpenMVS_USE_CUDA=OFF -DOpenMVS_USE_PYTHON=OFF -DOpenMVS_USE_BREAKPAD=OFF \

@@ -26,14 +26,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 build=${2:-$root/build}
 mkdir -p "$build/anchors"
 build=$(cd "$build" && pwd)
-if ! dpkg-query -W -f='${Status}' libjpeg-dev 2>/dev/null | grep -q "install ok installed"; then
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-  echo "build_pmvs2: installing libjpeg-dev"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends libjpeg-dev \
-    >/dev/null
-fi
+bash "$root/scripts/apt-install.sh" build_pmvs2 libjpeg-dev
 work="$build/anchors/pmvs-build"
 # PMVS2's CMake files predate CMake 3.5; the policy floor lets current CMake
 # configure them unchanged. Its sources are older C++ than today's compilers
