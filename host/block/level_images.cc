@@ -147,6 +147,11 @@ cv::Mat LevelImageStore::Load(const BlockImage& image, int level, int width, int
   return pixels;
 }
 
+const LevelImageStore& StoreOrNone(const LevelImageStore* store) {
+  static const LevelImageStore none;
+  return store ? *store : none;
+}
+
 void LevelImageStore::Clear() const {
   if (dir_.empty()) return;
   std::error_code ec;

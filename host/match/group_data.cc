@@ -35,8 +35,7 @@ double GdalBytesToMatch(const Block& block) {
 
 MatchGroupData LoadMatchGroup(const Block& block, const std::vector<int>& ids, int level,
                               const BlockGeometry* known_geometry, const LevelImageStore* levels) {
-  const LevelImageStore decode_each;
-  const LevelImageStore& store = levels ? *levels : decode_each;
+  const LevelImageStore& store = StoreOrNone(levels);
   MatchGroupData group;
   group.origin = block.origin;
   const BlockGeometry geometry = known_geometry ? *known_geometry : EstimateBlockGeometry(block);
@@ -140,9 +139,7 @@ cv::Mat LoadColorAtLevel(const Block& block, const MatchImage& image, int level,
                 ": image file changed while its group was matched (expected the file that "
                 "was loaded: its points take their colours from it)");
   }
-  const LevelImageStore decode_each;
-  return (levels ? *levels : decode_each)
-      .Load(bi, level, image.camera.width(), image.camera.height());
+  return StoreOrNone(levels).Load(bi, level, image.camera.width(), image.camera.height());
 }
 
 void SelectViews(const MatcherOptions& /*options*/, MatchGroupData* group) {

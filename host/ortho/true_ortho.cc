@@ -153,8 +153,7 @@ TrueOrtho MakeTrueOrtho(const Block& block, const GeoRaster& source_dsm, int lev
                         const OrthoOptions& options, double default_cell,
                         const std::function<void(int, int)>& progress,
                         const LevelImageStore* levels) {
-  const LevelImageStore decode_each;
-  const LevelImageStore& store = levels ? *levels : decode_each;
+  const LevelImageStore& store = StoreOrNone(levels);
   if (const std::string p = options.Problem(); !p.empty()) {
     throw Error("orthophoto: expected " + p);
   }

@@ -44,4 +44,8 @@ class LevelImageStore {
   double min_free_bytes_;
 };
 
+// `store`, or where it is null a store that keeps nothing: for the callers
+// that take an optional store, whose every read then decodes.
+const LevelImageStore& StoreOrNone(const LevelImageStore* store);
+
 }  // namespace sapmvs
